@@ -1,0 +1,93 @@
+#pragma once
+// The small interface every algorithm of Plano is written against. A backend decides
+// where a batched per-face kernel or a linear solve runs: the CPU reference (Eigen) or
+// Vulkan compute shaders. Algorithms never branch on the backend.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mesh/PolygonMesh.h"
+
+namespace plano::compute {
+
+enum class BackendKind { Cpu, Vulkan };
+
+/// Compressed-row sparse matrix, the layout both backends consume.
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+/// Result of the batched local step (projective-maps paper, Eq. 3), one entry per face.
+/// Row-vector convention: (p_i, 1) T_f = shat_i (q_i, 1) with T_f(3, 3) = 1, where
+/// shat_i = 1 / s_{f,i} is the reciprocal scale factor of corner i.
+struct ProjectiveFits {
+  std::vector<Eigen::Matrix4d> maps;      ///< #F maps.
+  std::vector<double> reciprocalScales;   ///< One per corner, in the FaceList's CSR order.
+  std::vector<double> residuals;          ///< Per face: RMS of the fit's equation residuals.
+  std::vector<int> ranks;                 ///< Per face: numerical rank of the fit's system.
+};
+
+/// Settings of an iterative or direct SPD solve.
+struct LinearSolverSettings {
+  double relativeTolerance = 1e-10;  ///< Iterative solvers stop at ||r|| <= tol * ||b||.
+  int maxIterations = 10000;         ///< Iterative solvers only.
+};
+
+/// What the last solve did.
+struct LinearSolveInfo {
+  int iterations = 0;         ///< 1 for a direct solve.
+  double relativeResidual = 0.0;
+  bool converged = true;
+};
+
+/// Solver for A X = B with A symmetric positive definite, A fixed at construction
+/// (factored or uploaded once), many right-hand sides over its lifetime.
+class SpdSolver {
+ public:
+  virtual ~SpdSolver() = default;
+  /// Solve A X = B column by column. X holds a warm start on entry (iterative solvers
+  /// use it; direct solvers ignore it) and the solution on exit.
+  virtual LinearSolveInfo solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
+  virtual Eigen::Index size() const = 0;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  virtual BackendKind kind() const = 0;
+  /// Human-readable name, e.g. "cpu" or "vulkan (llvmpipe ...)".
+  virtual std::string name() const = 0;
+
+  /// Planarity (percent, Planarity.h definition) of every face; out has #F entries.
+  virtual void facePlanarity(const PolygonMesh& mesh, std::span<double> out) = 0;
+
+  /// Batched local step: the projective map of every face from `source` to `target`
+  /// corners (both #V x 3), each face first projected onto its best-fitting plane; the
+  /// solution closest to the identity when not unique, least squares when over-determined.
+  virtual void fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
+                                 ProjectiveFits& out) = 0;
+
+  /// Batched orthogonal Procrustes (projective-maps paper, App. A): for each 3x3 matrix
+  /// M = U S V^T, the closest rotation R = U diag(1, 1, d) V^T with d = det(U V^T), and
+  /// the signed singular values (s1, s2, d * s3), so that R^T M = V diag(...) V^T.
+  virtual void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
+                                std::span<Eigen::Vector3d> singularValues) = 0;
+
+  /// A solver for the SPD system matrix A (prefactored or uploaded once).
+  virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;
+};
+
+/// Which backend the user asked for.
+enum class BackendChoice { Cpu, Vulkan, Auto };
+
+/// Parse "cpu", "vulkan" or "auto"; throws Error(Usage) otherwise.
+BackendChoice parseBackendChoice(const std::string& text);
+
+/// Create a backend. Vulkan failures throw Error(Device) when Vulkan was asked for; with
+/// Auto, Vulkan is used only on a real (non-CPU) GPU and any failure falls back to the CPU
+/// with a warning written to `warnings` (when not null).
+std::unique_ptr<Backend> createBackend(BackendChoice choice, std::string* warnings = nullptr);
+
+}  // namespace plano::compute

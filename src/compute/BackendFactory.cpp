@@ -1,0 +1,26 @@
+#include "compute/Backend.h"
+#include "compute/cpu/CpuBackend.h"
+#include "compute/vulkan/VulkanBackend.h"
+#include "core/Error.h"
+
+namespace plano::compute {
+
+BackendChoice parseBackendChoice(const std::string& text) {
+  if (text == "cpu") return BackendChoice::Cpu;
+  if (text == "vulkan") return BackendChoice::Vulkan;
+  if (text == "auto") return BackendChoice::Auto;
+  throwUsage("unknown backend '" + text + "' (use cpu, vulkan or auto)");
+}
+
+std::unique_ptr<Backend> createBackend(BackendChoice choice, std::string* warnings) {
+  if (choice == BackendChoice::Cpu) return std::make_unique<CpuBackend>();
+  if (choice == BackendChoice::Vulkan) return createVulkanBackend(VulkanDevicePreference::Any);
+  try {
+    return createVulkanBackend(VulkanDevicePreference::RealGpuOnly);
+  } catch (const Error& e) {
+    if (warnings) *warnings += "warning: using the CPU backend: " + std::string(e.what()) + "\n";
+    return std::make_unique<CpuBackend>();
+  }
+}
+
+}  // namespace plano::compute

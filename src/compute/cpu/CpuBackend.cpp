@@ -1,0 +1,93 @@
+#include "compute/cpu/CpuBackend.h"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
+#include <Eigen/SVD>
+
+#include "core/Error.h"
+#include "mesh/Planarity.h"
+#include "projective/LocalFit.h"
+
+namespace plano::compute {
+namespace {
+
+/// Prefactored sparse Cholesky (supernodal CHOLMOD). Solves are exact up to rounding.
+class CholmodSpdSolver final : public SpdSolver {
+ public:
+  explicit CholmodSpdSolver(const SparseMatrix& A) : size_(A.rows()) {
+    if (A.rows() != A.cols()) throwNumerical("SPD solver: matrix is not square");
+    columnMajor_ = A;
+    factor_.compute(columnMajor_);
+    if (factor_.info() != Eigen::Success) {
+      throwNumerical("SPD solver: Cholesky factorization failed (matrix not positive definite)");
+    }
+  }
+
+  LinearSolveInfo solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override {
+    X = factor_.solve(B);
+    LinearSolveInfo info;
+    info.iterations = 1;
+    const double bNorm = B.norm();
+    info.relativeResidual = bNorm > 0.0 ? (columnMajor_ * X - B).norm() / bNorm : 0.0;
+    info.converged = factor_.info() == Eigen::Success && std::isfinite(info.relativeResidual);
+    return info;
+  }
+
+  Eigen::Index size() const override { return size_; }
+
+ private:
+  Eigen::Index size_;
+  Eigen::SparseMatrix<double> columnMajor_;
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factor_;
+};
+
+}  // namespace
+
+void CpuBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out) {
+  for (Index f = 0; f < mesh.faceCount(); ++f) out[f] = plano::facePlanarity(mesh.vertices, mesh.faces[f]).mean;
+}
+
+void CpuBackend::fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
+                                   ProjectiveFits& out) {
+  const Index faceCount = faces.size();
+  out.maps.resize(faceCount);
+  out.reciprocalScales.resize(faces.cornerCount());
+  out.residuals.resize(faceCount);
+  out.ranks.resize(faceCount);
+  std::vector<Eigen::Vector3d> p;
+  std::vector<Eigen::Vector3d> q;
+  for (Index f = 0; f < faceCount; ++f) {
+    const auto face = faces[f];
+    p.clear();
+    q.clear();
+    for (Index v : face) {
+      p.emplace_back(source.row(v).transpose());
+      q.emplace_back(target.row(v).transpose());
+    }
+    const projective::ProjectiveFit fit = projective::fitProjectiveMap(p, q);
+    out.maps[f] = fit.map;
+    out.residuals[f] = fit.residual;
+    out.ranks[f] = fit.rank;
+    std::copy(fit.reciprocalScales.begin(), fit.reciprocalScales.end(),
+              out.reciprocalScales.begin() + faces.offsets()[f]);
+  }
+}
+
+void CpuBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
+                                  std::span<Eigen::Vector3d> singularValues) {
+  for (std::size_t i = 0; i < matrices.size(); ++i) {
+    Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrices[i], Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::Matrix3d& U = svd.matrixU();
+    const Eigen::Matrix3d& V = svd.matrixV();
+    const double d = (U * V.transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+    rotations[i] = U * Eigen::Vector3d(1.0, 1.0, d).asDiagonal() * V.transpose();
+    singularValues[i] = svd.singularValues();
+    singularValues[i][2] *= d;
+  }
+}
+
+std::unique_ptr<SpdSolver> CpuBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings&) {
+  return std::make_unique<CholmodSpdSolver>(A);
+}
+
+}  // namespace plano::compute

@@ -1,0 +1,46 @@
+#pragma once
+// Sub-commands of the `plano` tool register themselves here, one file per command in
+// tools/plano/commands/, so that adding a command touches no other file.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "compute/Backend.h"
+
+namespace plano::cli {
+
+/// Options every command shares (parsed before the sub-command runs).
+struct GlobalOptions {
+  std::string backend = "cpu";  ///< cpu | vulkan | auto
+  bool quiet = false;           ///< No progress on stderr.
+};
+
+/// A command's run function: returns the exit code. Errors are thrown as plano::Error
+/// and turned into messages and exit codes by main.
+using RunFunction = std::function<int(const GlobalOptions&)>;
+
+/// Sets up the sub-command's options on `app` and returns the function that runs it.
+using SetupFunction = std::function<RunFunction(CLI::App& app)>;
+
+struct CommandInfo {
+  std::string name;
+  std::string description;
+  SetupFunction setup;
+  int order = 100;  ///< Position in --help.
+};
+
+std::vector<CommandInfo>& commandRegistry();
+
+/// Static registration helper: `static CommandRegistration reg{{"info", "...", setup}};`
+struct CommandRegistration {
+  explicit CommandRegistration(CommandInfo info) { commandRegistry().push_back(std::move(info)); }
+};
+
+/// Create the backend the user asked for, printing a fallback warning on stderr.
+std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options);
+
+/// Progress line on stderr unless --quiet.
+void progress(const GlobalOptions& options, const std::string& message);
+
+}  // namespace plano::cli

@@ -1,0 +1,32 @@
+#include "plano/Report.h"
+
+#include "mesh/MeshIO.h"
+
+namespace plano::cli {
+
+nlohmann::json planarityJson(const PlanarityStats& stats) {
+  return {{"max", stats.max},
+          {"mean", stats.mean},
+          {"p95", stats.p95},
+          {"over_tolerance", stats.overTolerance},
+          {"tolerance", stats.tolerance},
+          {"max_run", stats.maxRun},
+          {"max_plane_fit_residual", stats.maxPlaneFitResidual}};
+}
+
+nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,
+                          const PlanarityStats& planarity, double seconds) {
+  return {{"command", command},
+          {"backend", backend},
+          {"vertices", mesh.vertexCount()},
+          {"faces", mesh.faceCount()},
+          {"planarity", planarityJson(planarity)},
+          {"seconds", seconds}};
+}
+
+void writeReport(const std::string& path, const nlohmann::json& report) {
+  if (path.empty()) return;
+  writeFileAtomically(path, report.dump(2) + "\n");
+}
+
+}  // namespace plano::cli

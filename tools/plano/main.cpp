@@ -1,0 +1,72 @@
+// plano: command-line tool for polyhedral meshes. Each sub-command lives in
+// tools/plano/commands/ and registers itself (Command.h).
+#include <algorithm>
+#include <iostream>
+
+#include "core/Error.h"
+#include "plano/Command.h"
+
+namespace plano::cli {
+
+std::vector<CommandInfo>& commandRegistry() {
+  static std::vector<CommandInfo> registry;
+  return registry;
+}
+
+std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options) {
+  std::string warnings;
+  auto backend = compute::createBackend(compute::parseBackendChoice(options.backend), &warnings);
+  if (!warnings.empty()) std::cerr << warnings;
+  return backend;
+}
+
+void progress(const GlobalOptions& options, const std::string& message) {
+  if (!options.quiet) std::cerr << message << std::endl;
+}
+
+}  // namespace plano::cli
+
+int main(int argc, char** argv) {
+  using namespace plano::cli;
+  CLI::App app{"plano: modelling polyhedral meshes (planar faces) with projective maps and linear spaces"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "plano 0.1.0");
+  GlobalOptions options;
+  app.add_option("--backend", options.backend, "Compute backend: cpu, vulkan or auto (Vulkan on a real GPU, else CPU)")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
+      ->capture_default_str();
+  app.add_flag("-q,--quiet", options.quiet, "No progress messages on stderr");
+
+  auto& registry = commandRegistry();
+  std::stable_sort(registry.begin(), registry.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
+  RunFunction selected;
+  std::vector<std::pair<CLI::App*, RunFunction>> commands;
+  for (const auto& info : registry) {
+    CLI::App* sub = app.add_subcommand(info.name, info.description);
+    // Global options are accepted after the sub-command name too: `plano info --backend cpu m.obj`.
+    sub->fallthrough();
+    commands.emplace_back(sub, info.setup(*sub));
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : plano::exitCode(plano::ErrorKind::Usage);
+  }
+
+  try {
+    for (auto& [sub, run] : commands) {
+      if (sub->parsed()) return run(options);
+    }
+    return plano::exitCode(plano::ErrorKind::Usage);
+  } catch (const plano::Error& e) {
+    std::cerr << "plano: " << plano::toString(e.kind()) << ": " << e.what() << std::endl;
+    return plano::exitCode(e.kind());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "plano: out of memory" << std::endl;
+    return plano::exitCode(plano::ErrorKind::Numerical);
+  } catch (const std::exception& e) {
+    std::cerr << "plano: internal error: " << e.what() << std::endl;
+    return 1;
+  }
+}
