@@ -1,12 +1,43 @@
 #include "compute/vulkan/VulkanBackend.h"
 
+#include "compute/cpu/CpuBackend.h"
+#include "compute/vulkan/VulkanContext.h"
+#include "compute/vulkan/VulkanFacePlanarity.h"
 #include "core/Error.h"
 
 namespace plano::compute {
 
-// Replaced by the Vulkan runtime (context, buffers, pipelines) in the Vulkan backend work.
-std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference) {
-  throwDevice("the Vulkan backend is not available in this build");
+VulkanBackend::VulkanBackend(VulkanDevicePreference preference)
+    : context_(std::make_unique<vk::Context>(vk::ContextSettings::fromEnvironment(
+          preference == VulkanDevicePreference::RealGpuOnly ? vk::DeviceSelection::RealGpuOnly
+                                                            : vk::DeviceSelection::Any))) {}
+
+VulkanBackend::~VulkanBackend() = default;
+
+std::string VulkanBackend::name() const { return "vulkan (" + context_->info().name + ")"; }
+
+void VulkanBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out) {
+  if (!planarity_) planarity_ = std::make_unique<vk::FacePlanarityKernel>(*context_);
+  planarity_->run(mesh, out);
+}
+
+// Not yet ported to the device: the CPU reference computes these.
+void VulkanBackend::fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
+                                      ProjectiveFits& out) {
+  CpuBackend().fitProjectiveMaps(faces, source, target, out);
+}
+
+void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
+                                     std::span<Eigen::Vector3d> singularValues) {
+  CpuBackend().closestRotations(matrices, rotations, singularValues);
+}
+
+std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
+  return CpuBackend().createSpdSolver(A, settings);
+}
+
+std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference preference) {
+  return std::make_unique<VulkanBackend>(preference);
 }
 
 }  // namespace plano::compute

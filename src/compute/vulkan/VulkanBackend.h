@@ -1,8 +1,14 @@
 #pragma once
-// The Vulkan compute backend: GLSL kernels from shaders/, embedded as SPIR-V.
+// The Vulkan compute backend: GLSL kernels from shaders/, embedded as SPIR-V, run on
+// the device of a Context that the backend owns (no process-global device state).
 #include <memory>
 
 #include "compute/Backend.h"
+
+namespace plano::vk {
+class Context;
+class FacePlanarityKernel;
+}  // namespace plano::vk
 
 namespace plano::compute {
 
@@ -11,9 +17,34 @@ enum class VulkanDevicePreference {
   RealGpuOnly,  ///< Refuse CPU implementations (used by --backend auto).
 };
 
+class VulkanBackend final : public Backend {
+ public:
+  /// Create the context (see createVulkanBackend); kernels' pipelines are built on first use.
+  explicit VulkanBackend(VulkanDevicePreference preference);
+  ~VulkanBackend() override;
+
+  BackendKind kind() const override { return BackendKind::Vulkan; }
+  std::string name() const override;
+
+  void facePlanarity(const PolygonMesh& mesh, std::span<double> out) override;
+  void fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
+                         ProjectiveFits& out) override;
+  void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
+                        std::span<Eigen::Vector3d> singularValues) override;
+  std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
+
+  /// The device context (device properties, validation messages).
+  vk::Context& context() { return *context_; }
+
+ private:
+  std::unique_ptr<vk::Context> context_;
+  std::unique_ptr<vk::FacePlanarityKernel> planarity_;
+};
+
 /// Create the Vulkan backend. The device can be forced with the environment variable
-/// PLANO_VULKAN_DEVICE (index or a substring of the device name). Throws Error(Device)
-/// with the reason when no suitable device exists (no loader, no device, no shaderFloat64).
+/// PLANO_VULKAN_DEVICE (index or a substring of the device name); PLANO_VULKAN_VALIDATION=1
+/// turns the validation layers on. Throws Error(Device) with the reason when no suitable
+/// device exists (no loader or driver, no device, no shaderFloat64).
 std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference preference);
 
 }  // namespace plano::compute

@@ -1,0 +1,71 @@
+#pragma once
+// Storage buffers on a Context, with a declared memory class (Kompute's typed tensors).
+// Device buffers live in device-local memory; where that memory is also host visible
+// (lavapipe, integrated GPUs) they are mapped and written directly, otherwise every
+// upload/download goes through a temporary staging buffer.
+#include <cstddef>
+#include <span>
+
+#include "compute/vulkan/VulkanContext.h"
+
+namespace plano::vk {
+
+enum class MemoryClass {
+  Device,  ///< Device-local; mapped when the device has unified memory, else staged.
+  Host,    ///< Host-visible and coherent (staging, small read-backs).
+};
+
+class Buffer {
+ public:
+  Buffer() = default;
+  /// A buffer of `bytes` bytes (at least 16, Vulkan forbids empty buffers). `what`
+  /// names its content in error messages. Throws Error(Device) on allocation failure.
+  Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, const char* what);
+  ~Buffer();
+  Buffer(Buffer&& other) noexcept;
+  Buffer& operator=(Buffer&& other) noexcept;
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  VkBuffer handle() const { return buffer_; }
+  std::size_t bytes() const { return bytes_; }
+  bool mapped() const { return mapped_ != nullptr; }
+
+  /// Copy `bytes` bytes from host memory into the buffer at `offset` (blocking).
+  void upload(const void* data, std::size_t bytes, std::size_t offset = 0);
+  /// Copy `bytes` bytes at `offset` of the buffer into host memory (blocking; the
+  /// caller has waited for the work that wrote it).
+  void download(void* data, std::size_t bytes, std::size_t offset = 0) const;
+
+ private:
+  void release();
+  void checkRange(std::size_t bytes, std::size_t offset, const char* operation) const;
+
+  Context* context_ = nullptr;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  void* mapped_ = nullptr;
+  std::size_t bytes_ = 0;
+  const char* what_ = "";
+};
+
+/// A Buffer of `count` elements of T (double, int32, uint32, ...).
+template <class T>
+class Array : public Buffer {
+ public:
+  Array() = default;
+  Array(Context& context, std::size_t count, MemoryClass memoryClass, const char* what)
+      : Buffer(context, count * sizeof(T), memoryClass, what), count_(count) {}
+  std::size_t count() const { return count_; }
+  void upload(std::span<const T> values, std::size_t first = 0) {
+    Buffer::upload(values.data(), values.size_bytes(), first * sizeof(T));
+  }
+  void download(std::span<T> values, std::size_t first = 0) const {
+    Buffer::download(values.data(), values.size_bytes(), first * sizeof(T));
+  }
+
+ private:
+  std::size_t count_ = 0;
+};
+
+}  // namespace plano::vk

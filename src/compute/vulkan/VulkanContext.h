@@ -1,0 +1,118 @@
+#pragma once
+// The Vulkan runtime's root object (Kompute's "manager"): instance, chosen physical
+// device, logical device, one compute queue and a command pool. Every buffer, pipeline
+// and sequence is created against a Context; nothing is process-global, so two backends
+// (or two tests) never share device state.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace plano::vk {
+
+/// Which physical devices are acceptable.
+enum class DeviceSelection {
+  Any,          ///< Best available: discrete GPU > integrated > virtual > CPU (lavapipe).
+  RealGpuOnly,  ///< Refuse CPU implementations (lavapipe, SwiftShader).
+};
+
+struct ContextSettings {
+  DeviceSelection selection = DeviceSelection::Any;
+  /// Index or case-insensitive name substring of the device to use; empty = best.
+  /// fromEnvironment() fills it from PLANO_VULKAN_DEVICE.
+  std::string deviceOverride;
+  /// Enable VK_LAYER_KHRONOS_validation and a debug messenger that records every
+  /// warning and error. fromEnvironment() sets it when PLANO_VULKAN_VALIDATION=1.
+  bool validation = false;
+  /// Upload and download through staging buffers even when device memory is host
+  /// visible (exercises the discrete-GPU path on lavapipe).
+  bool forceStaging = false;
+
+  /// Settings with deviceOverride and validation read from the environment.
+  static ContextSettings fromEnvironment(DeviceSelection selection);
+};
+
+/// What the chosen device offers; kernels check it before use.
+struct DeviceInfo {
+  std::string name;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::uint32_t index = 0;  ///< Position in vkEnumeratePhysicalDevices.
+  bool shaderFloat64 = false;
+  bool shaderInt64 = false;
+  std::uint32_t maxStorageBufferRange = 0;
+  std::uint32_t maxWorkGroupCount[3] = {0, 0, 0};
+  std::uint32_t maxWorkGroupInvocations = 0;
+  std::uint32_t maxSharedMemoryBytes = 0;
+  VkDeviceSize minStorageBufferOffsetAlignment = 1;
+  double timestampPeriodNs = 0.0;  ///< 0 when the queue has no timestamps.
+  bool unifiedMemory = false;      ///< A heap that is both device-local and host-visible.
+};
+
+class Context {
+ public:
+  /// Create instance and device. Throws Error(Device) naming the reason: no Vulkan
+  /// driver, no device, no device with shaderFloat64 and a compute queue, a forced
+  /// device that does not exist, a missing validation layer.
+  explicit Context(const ContextSettings& settings);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkDevice device() const { return device_; }
+  VkPhysicalDevice physicalDevice() const { return physicalDevice_; }
+  VkQueue queue() const { return queue_; }
+  VkCommandPool commandPool() const { return commandPool_; }
+  const DeviceInfo& info() const { return info_; }
+  const ContextSettings& settings() const { return settings_; }
+
+  /// Memory type for `typeBits` with all `required` flags, preferring `preferred`;
+  /// throws Error(Device) when none exists.
+  std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
+                           VkMemoryPropertyFlags preferred) const;
+
+  /// Validation messages (warnings and errors) received so far; always empty when
+  /// validation is off.
+  std::vector<std::string> validationMessages() const;
+  std::size_t validationMessageCount() const;
+
+  /// Throw Error(Device) "<what>: <VkResult name>" unless result is VK_SUCCESS.
+  static void check(VkResult result, const char* what);
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                       VkDebugUtilsMessageTypeFlagsEXT types,
+                                                       const VkDebugUtilsMessengerCallbackDataEXT* data, void* self);
+  void createInstance();
+  void choosePhysicalDevice();
+  void createDevice();
+  void destroy();
+
+  ContextSettings settings_;
+  DeviceInfo info_;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memory_{};
+  std::uint32_t queueFamily_ = 0;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool commandPool_ = VK_NULL_HANDLE;
+
+  mutable std::mutex messagesMutex_;
+  std::vector<std::string> messages_;
+};
+
+/// A zero-initialised Vulkan info structure with its sType set.
+template <class T>
+T vkStruct(VkStructureType type) {
+  T value{};
+  value.sType = type;
+  return value;
+}
+
+/// Name of a VkResult, e.g. "VK_ERROR_DEVICE_LOST".
+const char* resultName(VkResult result);
+
+}  // namespace plano::vk

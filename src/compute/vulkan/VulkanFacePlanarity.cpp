@@ -1,0 +1,60 @@
+#include "compute/vulkan/VulkanFacePlanarity.h"
+
+#include <algorithm>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct Push {
+  std::uint32_t firstFace;
+  std::uint32_t faceCount;
+};
+
+}  // namespace
+
+FacePlanarityKernel::FacePlanarityKernel(Context& context)
+    : context_(context), pipeline_(context, "face_planarity", 4, sizeof(Push)) {}
+
+void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
+  const std::size_t faceCount = static_cast<std::size_t>(mesh.faceCount());
+  if (out.size() != faceCount) {
+    throwUsage("facePlanarity: output has " + std::to_string(out.size()) + " entries for " +
+               std::to_string(faceCount) + " faces");
+  }
+  if (faceCount == 0) return;
+  const std::size_t range = context_.info().maxStorageBufferRange;
+  const std::size_t positionBytes = static_cast<std::size_t>(mesh.vertices.size()) * sizeof(double);
+  const std::size_t cornerBytes = mesh.faces.indices().size() * sizeof(Index);
+  if (positionBytes > range || cornerBytes > range) {
+    throwDevice("Vulkan: the mesh (" + std::to_string(mesh.vertexCount()) + " vertices, " +
+                std::to_string(mesh.faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
+                std::to_string(range) + " bytes; use the CPU backend");
+  }
+
+  Array<double> positions(context_, mesh.vertices.size(), MemoryClass::Device, "vertex positions");
+  positions.upload({mesh.vertices.data(), static_cast<std::size_t>(mesh.vertices.size())});
+  Array<Index> offsets(context_, mesh.faces.offsets().size(), MemoryClass::Device, "face offsets");
+  offsets.upload(mesh.faces.offsets());
+  Array<Index> indices(context_, mesh.faces.indices().size(), MemoryClass::Device, "face corners");
+  indices.upload(mesh.faces.indices());
+
+  // The output is the one per-face array; split the faces so each chunk's fits one binding.
+  const std::size_t chunk = std::min(faceCount, range / sizeof(double));
+  Array<double> values(context_, chunk, MemoryClass::Device, "face planarity");
+  DescriptorSet set(context_, pipeline_, {positions, offsets, indices, values});
+  Sequence sequence(context_);
+  for (std::size_t first = 0; first < faceCount; first += chunk) {
+    const std::size_t count = std::min(chunk, faceCount - first);
+    sequence.begin();
+    sequence.dispatch(pipeline_, set, Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(count)},
+                      groupsFor(context_, count));
+    sequence.end();
+    sequence.run();
+    values.download(out.subspan(first, count));
+  }
+}
+
+}  // namespace plano::vk

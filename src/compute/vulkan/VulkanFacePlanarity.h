@@ -1,0 +1,26 @@
+#pragma once
+// Per-face planarity on the device (shaders/face_planarity.comp), the definition of
+// src/mesh/Planarity.h, double precision.
+#include <span>
+
+#include "compute/vulkan/VulkanSequence.h"
+#include "mesh/PolygonMesh.h"
+
+namespace plano::vk {
+
+class FacePlanarityKernel {
+ public:
+  /// Builds the pipeline (once per backend).
+  explicit FacePlanarityKernel(Context& context);
+
+  /// Planarity in percent of every face of `mesh` into out (#F entries). Uploads the
+  /// mesh, runs in chunks of faces that fit the device's storage-buffer range.
+  /// Throws Error(Device) when the positions or corners alone exceed that range.
+  void run(const PolygonMesh& mesh, std::span<double> out);
+
+ private:
+  Context& context_;
+  Pipeline pipeline_;
+};
+
+}  // namespace plano::vk

@@ -1,0 +1,54 @@
+#pragma once
+// A recorded sequence of device operations (Kompute's Sequence): copies, dispatches and
+// barriers recorded once into a command buffer and submitted as one batch, as often as
+// needed. Timestamps at the start and end of each recording give the device time.
+#include <cstdint>
+#include <span>
+
+#include "compute/vulkan/VulkanPipeline.h"
+
+namespace plano::vk {
+
+class Sequence {
+ public:
+  explicit Sequence(Context& context);
+  ~Sequence();
+  Sequence(const Sequence&) = delete;
+  Sequence& operator=(const Sequence&) = delete;
+
+  /// Start (re)recording; discards the previous recording.
+  void begin();
+  /// Record a dispatch of `groupsX` x `groupsY` workgroups with the given push constants.
+  void dispatch(const Pipeline& pipeline, const DescriptorSet& set, std::span<const std::byte> pushConstants,
+                std::uint32_t groupsX, std::uint32_t groupsY = 1);
+  template <class Push>
+  void dispatch(const Pipeline& pipeline, const DescriptorSet& set, const Push& push, std::uint32_t groupsX,
+                std::uint32_t groupsY = 1) {
+    dispatch(pipeline, set, std::as_bytes(std::span<const Push>(&push, 1)), groupsX, groupsY);
+  }
+  /// Make every earlier shader or transfer write visible to every later shader or transfer.
+  void barrier();
+  void copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset = 0,
+            std::size_t destinationOffset = 0);
+  /// Finish recording (writes the end timestamp and a host-visibility barrier).
+  void end();
+
+  /// Submit the recording and wait for it. Throws Error(Device) on device loss or when
+  /// the device does not finish within `timeoutSeconds`.
+  void run(double timeoutSeconds = 600.0);
+
+  /// Device time of the last run() in seconds, from timestamp queries; a negative value
+  /// when the queue has no timestamps.
+  double lastDeviceSeconds() const;
+
+ private:
+  Context& context_;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool queries_ = VK_NULL_HANDLE;
+  bool recording_ = false;
+  bool recorded_ = false;
+  bool ran_ = false;
+};
+
+}  // namespace plano::vk

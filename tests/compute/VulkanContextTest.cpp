@@ -1,0 +1,60 @@
+// The Vulkan context: device choice, feature detection, and a validation messenger
+// that really records messages (otherwise "zero messages" in every other test means nothing).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "compute/vulkan/VulkanContext.h"
+#include "core/Error.h"
+
+namespace plano::test {
+namespace {
+
+vk::ContextSettings validatedSettings() {
+  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
+  settings.validation = true;
+  return settings;
+}
+
+TEST(VulkanContext, ReportsDoublePrecisionAndLimits) {
+  vk::Context context(validatedSettings());
+  EXPECT_TRUE(context.info().shaderFloat64);
+  EXPECT_GT(context.info().maxStorageBufferRange, 0u);
+  EXPECT_GE(context.info().maxWorkGroupCount[0], 65535u);
+  EXPECT_FALSE(context.info().name.empty());
+}
+
+TEST(VulkanContext, ValidationMessengerRecordsInvalidUsage) {
+  vk::Context context(validatedSettings());
+  ASSERT_EQ(context.validationMessageCount(), 0u);
+  // A zero-sized buffer violates VUID-VkBufferCreateInfo-size-00912.
+  auto info = vk::vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+  info.size = 0;
+  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  vkCreateBuffer(context.device(), &info, nullptr, &buffer);
+  if (buffer) vkDestroyBuffer(context.device(), buffer, nullptr);
+  EXPECT_GT(context.validationMessageCount(), 0u);
+}
+
+TEST(VulkanContext, ForcedDeviceByIndexIsUsed) {
+  vk::ContextSettings settings = validatedSettings();
+  settings.deviceOverride = "0";
+  vk::Context context(settings);
+  EXPECT_EQ(context.info().index, 0u);
+}
+
+TEST(VulkanContext, RealGpuOnlyRefusesCpuImplementationsWithReason) {
+  vk::ContextSettings settings = validatedSettings();
+  settings.selection = vk::DeviceSelection::RealGpuOnly;
+  try {
+    vk::Context context(settings);
+    EXPECT_NE(context.info().type, VK_PHYSICAL_DEVICE_TYPE_CPU);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device);
+    EXPECT_NE(std::string(e.what()).find("CPU implementation"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace plano::test

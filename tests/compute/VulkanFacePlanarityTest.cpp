@@ -1,0 +1,98 @@
+// Vulkan per-face planarity against the CPU reference (fp64, 1e-12 relative).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "compute/VulkanFixture.h"
+#include "compute/cpu/CpuBackend.h"
+#include "compute/vulkan/VulkanFacePlanarity.h"
+#include "core/Error.h"
+#include "mesh/Generators.h"
+#include "support/TestMeshes.h"
+
+namespace plano::test {
+namespace {
+
+/// Largest |vulkan - cpu| / max(|cpu|, 1) over the faces; planarity is in percent, so
+/// the floor of 1 makes exactly planar faces (values at rounding level) compare absolutely.
+double worstRelativeDifference(compute::Backend& backend, const PolygonMesh& mesh) {
+  std::vector<double> gpu(mesh.faceCount()), cpu(mesh.faceCount());
+  backend.facePlanarity(mesh, gpu);
+  compute::CpuBackend().facePlanarity(mesh, cpu);
+  double worst = 0.0;
+  for (Index f = 0; f < mesh.faceCount(); ++f) {
+    worst = std::max(worst, std::abs(gpu[f] - cpu[f]) / std::max(std::abs(cpu[f]), 1.0));
+  }
+  return worst;
+}
+
+/// Random polygon soup: faces of 3..7 distinct random vertices of random positions.
+PolygonMesh randomPolygons(Index vertexCount, Index faceCount, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::uniform_int_distribution<Index> degree(3, 7);
+  PolygonMesh mesh;
+  mesh.vertices.resize(vertexCount, 3);
+  for (Index i = 0; i < mesh.vertices.size(); ++i) mesh.vertices.data()[i] = coordinate(rng);
+  std::vector<Index> all(vertexCount);
+  for (Index v = 0; v < vertexCount; ++v) all[v] = v;
+  for (Index f = 0; f < faceCount; ++f) {
+    std::shuffle(all.begin(), all.end(), rng);
+    mesh.faces.addFace(std::span<const Index>(all.data(), static_cast<std::size_t>(degree(rng))));
+  }
+  return mesh;
+}
+
+class VulkanFacePlanarity : public VulkanTest {};
+
+TEST_F(VulkanFacePlanarity, MatchesCpuOnRandomPolygons) {
+  EXPECT_LT(worstRelativeDifference(backend(), randomPolygons(200, 3000, 1)), 1e-12);
+}
+
+TEST_F(VulkanFacePlanarity, MatchesCpuOnGeneratedQuadMeshes) {
+  EXPECT_LT(worstRelativeDifference(backend(), generate::translationalSurface(40, 30)), 1e-12);
+  EXPECT_LT(worstRelativeDifference(backend(), generate::surfaceOfRevolution(32, 12)), 1e-12);
+  EXPECT_LT(worstRelativeDifference(backend(), generate::hyparGrid(50, 0.7)), 1e-12);
+  EXPECT_LT(worstRelativeDifference(backend(), generate::cube()), 1e-12);
+}
+
+TEST_F(VulkanFacePlanarity, MatchesCpuOnPentagonsAndHexagons) {
+  EXPECT_LT(worstRelativeDifference(backend(), generate::dodecahedron()), 1e-12);
+  EXPECT_LT(worstRelativeDifference(backend(), generate::hexagonalDome(12)), 1e-12);
+  PolygonMesh noisy = generate::hexagonalDome(10);
+  noisy.vertices = perturbed(noisy.vertices, 0.01);
+  EXPECT_LT(worstRelativeDifference(backend(), noisy), 1e-12);
+}
+
+TEST_F(VulkanFacePlanarity, NonPlanarFacesHaveTheCpuValuesNotJustZero) {
+  // Guards against a kernel that writes zeros: the hypar grid's faces are clearly skew.
+  const PolygonMesh mesh = generate::hyparGrid(8, 0.5);
+  std::vector<double> values(mesh.faceCount());
+  backend().facePlanarity(mesh, values);
+  EXPECT_GT(*std::max_element(values.begin(), values.end()), 0.1);
+}
+
+TEST_F(VulkanFacePlanarity, EmptyMeshGivesNoValues) {
+  PolygonMesh mesh;
+  std::vector<double> values;
+  EXPECT_NO_THROW(backend().facePlanarity(mesh, values));
+}
+
+TEST_F(VulkanFacePlanarity, StagingUploadPathGivesTheSameValues) {
+  // The discrete-GPU path (device-local memory + staging copies), forced on lavapipe.
+  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
+  settings.validation = true;
+  settings.forceStaging = true;
+  vk::Context staged(settings);
+  vk::FacePlanarityKernel kernel(staged);
+  PolygonMesh mesh = generate::hyparGrid(30, 0.4);
+  std::vector<double> gpu(mesh.faceCount()), cpu(mesh.faceCount());
+  kernel.run(mesh, gpu);
+  compute::CpuBackend().facePlanarity(mesh, cpu);
+  for (Index f = 0; f < mesh.faceCount(); ++f) ASSERT_NEAR(gpu[f], cpu[f], 1e-12 * std::max(cpu[f], 1.0)) << "face " << f;
+  EXPECT_EQ(staged.validationMessageCount(), 0u) << (staged.validationMessages().empty() ? "" : staged.validationMessages()[0]);
+}
+
+}  // namespace
+}  // namespace plano::test
