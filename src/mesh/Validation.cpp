@@ -343,7 +343,10 @@ ValidationReport validate(const PolygonMesh& mesh, const ValidationSettings& set
 }
 
 void requireValid(const PolygonMesh& mesh, const std::string& source, const ValidationSettings& settings) {
-  const ValidationReport report = validate(mesh, settings);
+  requireValid(validate(mesh, settings), source);
+}
+
+void requireValid(const ValidationReport& report, const std::string& source) {
   if (report.valid()) return;
   constexpr std::size_t kShown = 3;
   std::string message = source + ": ";
