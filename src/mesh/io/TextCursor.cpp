@@ -113,11 +113,12 @@ double TextCursor::toDouble(std::string_view token, const char* what) const {
   const std::string_view digits = withoutPlus(token);
   double value = 0.0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (end != digits.data() + digits.size() || digits.empty() ||
+      (ec != std::errc() && ec != std::errc::result_out_of_range)) {
+    fail(std::string(what) + " " + quoted(token) + " is not a number");
+  }
   if (ec == std::errc::result_out_of_range) {
     fail(std::string(what) + " " + quoted(token) + " is out of the range of double precision");
-  }
-  if (ec != std::errc() || end != digits.data() + digits.size() || digits.empty()) {
-    fail(std::string(what) + " " + quoted(token) + " is not a number");
   }
   if (!std::isfinite(value)) fail(std::string(what) + " " + quoted(token) + " is not finite");
   return value;
@@ -127,10 +128,11 @@ std::int64_t TextCursor::toInteger(std::string_view token, const char* what) con
   const std::string_view digits = withoutPlus(token);
   std::int64_t value = 0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-  if (ec == std::errc::result_out_of_range) fail(std::string(what) + " " + quoted(token) + " is too large");
-  if (ec != std::errc() || end != digits.data() + digits.size() || digits.empty()) {
+  if (end != digits.data() + digits.size() || digits.empty() ||
+      (ec != std::errc() && ec != std::errc::result_out_of_range)) {
     fail(std::string(what) + " " + quoted(token) + " is not an integer");
   }
+  if (ec == std::errc::result_out_of_range) fail(std::string(what) + " " + quoted(token) + " is too large");
   return value;
 }
 
