@@ -53,6 +53,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
   if (handleCount > 0) targets.bottomRows(handleCount) = handles;
 
   const double diagonal = space_.normalization().scale;
+  const double planarityBound = std::max(settings_.planarityTolerance, planarityStats(space_.baseMesh()).max);
   DeformationInfo info;
   auto record = [&](DeformationPhase phase, const GlobalStepInfo& step, const Positions& next) {
     DeformationIteration it;
@@ -86,12 +87,12 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     }
     // Phase 2 (§5 loop): projective fits of the current faces, projected with the same
     // constraints, until the faces are planar again.
-    bool planar = !info.history.empty() && info.history.back().maxPlanarity <= settings_.planarityTolerance;
+    bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
     for (int k = 0; k < settings_.maxProjectionIterations && !planar; ++k) {
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
       const Positions next = space_.positions(maps.maps);
-      planar = record(DeformationPhase::Projection, step, next).maxPlanarity <= settings_.planarityTolerance;
+      planar = record(DeformationPhase::Projection, step, next).maxPlanarity <= planarityBound;
       positions = next;
     }
     info.status = converged && planar ? DeformationStatus::Converged : DeformationStatus::MaxIterationsReached;

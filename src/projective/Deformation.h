@@ -27,7 +27,8 @@ struct DeformationSettings {
   /// Stop when max_v |q_v^k - q_v^(k-1)| < tolerance * bounding-box diagonal.
   double tolerance = 1e-4;
   /// Percent (paper's measure). After the rigid/similar phase, the §5 projection phase
-  /// runs while the max face planarity exceeds this.
+  /// runs while the max face planarity exceeds this or the base mesh's own max planarity,
+  /// whichever is larger (a deformation is not asked to be flatter than its input).
   double planarityTolerance = 0.1;
   int maxProjectionIterations = 20;
   /// Global step settings. Deformation tries eps = 0 first: the affine shape space of a
