@@ -76,18 +76,7 @@ ConstraintMatrix buildConstraintMatrix(const PolygonMesh& Y, std::span<const Fac
       space = FaceSpace::Parallel;
     }
     B.effective[f] = space;
-    switch (space) {
-      case FaceSpace::Affine: {
-        const Eigen::MatrixXd scalar = affineFaceBlock(frame);
-        block = Eigen::MatrixXd::Zero(3 * scalar.rows(), 3 * k);
-        for (Eigen::Index r = 0; r < scalar.rows(); ++r)
-          for (Index i = 0; i < k; ++i)
-            for (int c = 0; c < 3; ++c) block(3 * r + c, 3 * i + c) = scalar(r, i);
-        break;
-      }
-      case FaceSpace::Parallel: block = parallelFaceBlock(frame); break;
-      case FaceSpace::Vertical: block = verticalFaceBlock(frame, settings.up); break;
-    }
+    block = faceBlock(frame, space, settings.up);
     for (Eigen::Index r = 0; r < block.rows(); ++r)
       for (Index i = 0; i < k; ++i)
         for (int c = 0; c < 3; ++c) {

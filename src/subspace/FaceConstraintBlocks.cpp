@@ -64,6 +64,21 @@ Eigen::MatrixXd parallelFaceBlock(const FaceFrame& frame) {
   return block;
 }
 
+Eigen::MatrixXd faceBlock(const FaceFrame& frame, FaceSpace space, const Eigen::Vector3d& up) {
+  switch (space) {
+    case FaceSpace::Parallel: return parallelFaceBlock(frame);
+    case FaceSpace::Vertical: return verticalFaceBlock(frame, up);
+    case FaceSpace::Affine: break;
+  }
+  const Eigen::MatrixXd scalar = affineFaceBlock(frame);
+  const Eigen::Index k = frame.planar.rows();
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(3 * scalar.rows(), 3 * k);
+  for (Eigen::Index r = 0; r < scalar.rows(); ++r)
+    for (Eigen::Index i = 0; i < k; ++i)
+      for (int c = 0; c < 3; ++c) block(3 * r + c, 3 * i + c) = scalar(r, i);
+  return block;
+}
+
 bool isHorizontal(const FaceFrame& frame, const Eigen::Vector3d& up, double tolerance) {
   return up.normalized().cross(frame.normal).norm() <= tolerance;
 }

@@ -12,6 +12,7 @@
 #include <span>
 
 #include "mesh/PolygonMesh.h"
+#include "subspace/FaceSpace.h"
 
 namespace plano::subspace {
 
@@ -46,6 +47,10 @@ Eigen::MatrixXd parallelFaceBlock(const FaceFrame& frame);
 /// every member is N z^T + w Y_2^T + t 1^T, i.e. corners slide freely along N and the
 /// face turns about N. Precondition: up is not parallel to n (see isHorizontal).
 Eigen::MatrixXd verticalFaceBlock(const FaceFrame& frame, const Eigen::Vector3d& up);
+
+/// The block of any type acting on the face's 3k coordinates (the affine scalar block
+/// expanded to its three coordinate copies), rows ordered 3 r + c for the affine case.
+Eigen::MatrixXd faceBlock(const FaceFrame& frame, FaceSpace space, const Eigen::Vector3d& up);
 
 /// Whether the face plane is perpendicular to `up` (|up x n| <= tolerance), where the
 /// vertical relationship degenerates to the parallel one (sub-case 1 of type 2).
