@@ -7,6 +7,7 @@
 // shared meshes come from ../shared/data or $PLANO_SHARED_DATA.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -132,7 +133,7 @@ void BM_Planarize(benchmark::State& state, planarize::Method method, std::string
   planarize::Settings settings;
   settings.method = method;
   settings.tolerance = tolerance;
-  settings.maxIterations = method == planarize::Method::ShapeUp ? 1000 : 300;
+  settings.maxIterations = method == planarize::Method::GaussNewton ? 30 : (method == planarize::Method::ShapeUp ? 1000 : 300);
   planarize::Info info;
   for (auto _ : state) {
     plano::Positions vertices = mesh->vertices;
@@ -154,6 +155,9 @@ void registerTable() {
                                            "spot_quad.obj:cc2"};
   for (const auto method : {planarize::Method::GaussNewton, planarize::Method::Anderson, planarize::Method::ShapeUp}) {
     for (const auto& mesh : meshes) {
+      // The baseline never reaches 1 % on the 47k-face input within 300 iterations; plain
+      // ShapeUp is not run there.
+      if (method == planarize::Method::ShapeUp && mesh == "spot_quad.obj:cc2") continue;
       for (const double tolerance : {1.0, 0.1}) {
         const std::string label = std::string("BM_Planarize/") + planarize::toString(method) + "/" + mesh + "/to_" +
                                   (tolerance == 1.0 ? "1pct" : "0.1pct");
@@ -166,7 +170,8 @@ void registerTable() {
   }
 }
 
-/// Per-iteration time: a fixed number of iterations with an unreachable tolerance.
+/// Per-iteration time: a run of 5 iterations minus a run of 0 (precompute only), with an
+/// unreachable tolerance, over 5.
 void BM_PlanarizeIteration(benchmark::State& state, planarize::Method method, std::string name) {
   const PolygonMesh* mesh = input(name);
   if (!mesh) {
@@ -177,15 +182,21 @@ void BM_PlanarizeIteration(benchmark::State& state, planarize::Method method, st
   planarize::Settings settings;
   settings.method = method;
   settings.tolerance = 0.0;
-  settings.maxIterations = 5;
   double iterationSeconds = 0.0;
   int iterations = 0;
   for (auto _ : state) {
-    plano::Positions vertices = mesh->vertices;
-    const auto start = std::chrono::steady_clock::now();
-    const planarize::Info info = planarize::planarize(mesh->faces, vertices, settings, backend);
-    iterationSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    iterations += info.iterations;
+    double seconds[2];
+    int done = 0;
+    for (const int cap : {0, 5}) {
+      settings.maxIterations = cap;
+      plano::Positions vertices = mesh->vertices;
+      const auto start = std::chrono::steady_clock::now();
+      const planarize::Info info = planarize::planarize(mesh->faces, vertices, settings, backend);
+      seconds[cap == 0 ? 0 : 1] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      done = info.iterations;
+    }
+    iterationSeconds += seconds[1] - seconds[0];
+    iterations += done;
   }
   state.counters["faces"] = mesh->faceCount();
   state.counters["ms_per_iteration"] = 1e3 * iterationSeconds / std::max(iterations, 1);
