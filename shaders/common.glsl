@@ -1,12 +1,12 @@
 // Shared declarations for Plano's compute shaders (included with #include "common.glsl").
 #extension GL_ARB_gpu_shader_fp64 : require
 
-// Every 1D kernel uses this workgroup size (vk::kWorkGroupSize on the host) and a
-// grid-stride loop, because the workgroup count per dimension is capped (65535 on
+// The default workgroup size of 1D kernels (vk::kWorkGroupSize on the host). Kernels
+// loop grid-stride, because the workgroup count per dimension is capped (65535 on
 // lavapipe) below the number of faces of a large mesh.
 #define PLANO_GROUP_SIZE 64
 #define GRID_STRIDE_LOOP(i, count) \
-  for (uint i = gl_GlobalInvocationID.x; i < (count); i += gl_NumWorkGroups.x * PLANO_GROUP_SIZE)
+  for (uint i = gl_GlobalInvocationID.x; i < (count); i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
 
 // Vector helpers written out so that the operation order matches the CPU reference
 // (Eigen, compiled with -ffp-contract=off); `precise` forbids fused multiply-adds.

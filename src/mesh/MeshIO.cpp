@@ -1,102 +1,163 @@
 #include "mesh/MeshIO.h"
 
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
-#include <algorithm>
-#include <cstdio>
-#include <fstream>
-#include <random>
-#include <sstream>
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <random>
+
 #include "core/Error.h"
+#include "mesh/io/ObjFormat.h"
+#include "mesh/io/OffFormat.h"
+#include "mesh/io/PlyFormat.h"
 
 namespace plano {
 namespace {
 
-using OMesh = OpenMesh::PolyMesh_ArrayKernelT<OpenMesh::DefaultTraitsDouble>;
-
-std::string lowerExtension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
+std::string readWholeFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throwBadInput(path.string() + ": no such file");
+  if (std::filesystem::is_directory(status)) throwBadInput(path.string() + ": is a directory, not a mesh file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throwBadInput(path.string() + ": cannot be opened for reading");
+  std::string data;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (size > 0) {
+    data.resize(static_cast<std::size_t>(size));
+    in.read(data.data(), size);
+    if (in.gcount() != size) throwBadInput(path.string() + ": read error");
+  } else {
+    // Not seekable (a pipe, /dev/stdin): read to the end.
+    data.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return data;
 }
 
-void requireKnownExtension(const std::filesystem::path& path) {
-  const std::string ext = lowerExtension(path);
-  if (ext != ".obj" && ext != ".off" && ext != ".ply") {
-    throwUsage(path.string() + ": unknown mesh format '" + ext + "' (use .obj, .off or .ply)");
+/// A mesh whose file content would not read back as the same mesh is refused.
+void requireWritable(const std::filesystem::path& path, const PolygonMesh& mesh) {
+  for (Index v = 0; v < mesh.vertexCount(); ++v) {
+    if (!mesh.vertices.row(v).allFinite()) {
+      throwBadInput(path.string() + ": cannot write: vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
+  for (Index f = 0; f < mesh.faceCount(); ++f) {
+    for (Index v : mesh.faces[f]) {
+      if (v < 0 || v >= mesh.vertexCount()) {
+        throwBadInput(path.string() + ": cannot write: face " + std::to_string(f) + " has vertex index " +
+                      std::to_string(v) + " out of range [0, " + std::to_string(mesh.vertexCount()) + ")");
+      }
+    }
   }
 }
 
 }  // namespace
 
-PolygonMesh readMesh(const std::filesystem::path& path) {
-  requireKnownExtension(path);
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throwBadInput(path.string() + ": no such file");
-  OMesh om;
-  if (!OpenMesh::IO::read_mesh(om, path.string())) throwBadInput(path.string() + ": could not be read as a mesh");
-  PolygonMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(om.n_vertices()), 3);
-  for (auto vh : om.vertices()) {
-    const auto& p = om.point(vh);
-    mesh.vertices.row(vh.idx()) << p[0], p[1], p[2];
+MeshFormat meshFormatFromPath(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".obj") return MeshFormat::Obj;
+  if (ext == ".off") return MeshFormat::Off;
+  if (ext == ".ply") return MeshFormat::Ply;
+  throwUsage(path.string() + ": unknown mesh format '" + ext + "' (use .obj, .off or .ply)");
+}
+
+PolygonMesh parseMesh(std::string_view data, MeshFormat format, const std::string& source,
+                      const ReadOptions& options) {
+  if (data.empty()) throwBadInput(source + ": file is empty");
+  if (std::all_of(data.begin(), data.end(), [](char c) { return std::isspace(static_cast<unsigned char>(c)); })) {
+    throwBadInput(source + ": file contains only whitespace");
   }
-  std::vector<Index> face;
-  for (auto fh : om.faces()) {
-    face.clear();
-    for (auto vh : om.fv_range(fh)) face.push_back(vh.idx());
-    mesh.faces.addFace(std::span<const Index>(face));
+  PolygonMesh mesh;
+  switch (format) {
+    case MeshFormat::Obj: mesh = io::parseObj(data, source, options.warnings); break;
+    case MeshFormat::Off: mesh = io::parseOff(data, source, options.warnings); break;
+    case MeshFormat::Ply: mesh = io::parsePly(data, source, options.warnings); break;
+  }
+  if (mesh.faceCount() == 0) {
+    throwBadInput(source + ": no faces (" + std::to_string(mesh.vertexCount()) + " vertices and no polygon)");
+  }
+  if (options.validate) {
+    const ValidationReport report = validate(mesh, options.validation);
+    requireValid(report, source);
+    if (options.warnings) {
+      for (const auto& issue : report.issues) {
+        if (issue.severity == Severity::Warning) options.warnings->push_back(source + ": " + issue.message);
+      }
+    }
   }
   return mesh;
 }
 
-void writeFileAtomically(const std::filesystem::path& path, const std::string& content) {
-  const std::filesystem::path target = std::filesystem::absolute(path);
-  std::random_device rd;
-  const std::filesystem::path temp =
-      target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + "-" +
-                              std::to_string(rd()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throwBadInput(path.string() + ": cannot write (folder missing or not writable)");
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.flush();
-    if (!out) {
-      out.close();
-      std::filesystem::remove(temp);
-      throwBadInput(path.string() + ": write failed (disk full?)");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, target, ec);
-  if (ec) {
-    std::filesystem::remove(temp);
-    throwBadInput(path.string() + ": cannot replace file: " + ec.message());
-  }
+PolygonMesh readMesh(const std::filesystem::path& path, const ReadOptions& options) {
+  const MeshFormat format = meshFormatFromPath(path);
+  const std::string data = readWholeFile(path);
+  return parseMesh(data, format, path.string(), options);
 }
 
-void writeMesh(const std::filesystem::path& path, const PolygonMesh& mesh) {
-  requireKnownExtension(path);
-  OMesh om;
-  std::vector<OMesh::VertexHandle> handles(static_cast<std::size_t>(mesh.vertexCount()));
-  for (Index v = 0; v < mesh.vertexCount(); ++v) {
-    handles[v] = om.add_vertex(OMesh::Point(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2)));
+std::string formatMesh(const PolygonMesh& mesh, MeshFormat format, const WriteOptions& options) {
+  switch (format) {
+    case MeshFormat::Obj: return io::formatObj(mesh);
+    case MeshFormat::Off: return io::formatOff(mesh);
+    case MeshFormat::Ply: return io::formatPly(mesh, options.plyEncoding);
   }
-  std::vector<OMesh::VertexHandle> face;
-  for (Index f = 0; f < mesh.faceCount(); ++f) {
-    face.clear();
-    for (Index v : mesh.faces[f]) face.push_back(handles[v]);
-    if (!om.add_face(face).is_valid()) {
-      throwBadInput(path.string() + ": face " + std::to_string(f) + " cannot be written (non-manifold)");
+  return {};
+}
+
+void writeMesh(const std::filesystem::path& path, const PolygonMesh& mesh, const WriteOptions& options) {
+  const MeshFormat format = meshFormatFromPath(path);
+  requireWritable(path, mesh);
+  writeFileAtomically(path, formatMesh(mesh, format, options));
+}
+
+void writeFileAtomically(const std::filesystem::path& path, const std::string& content) {
+  const std::filesystem::path target = std::filesystem::absolute(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(target, ec)) throwBadInput(path.string() + ": is a directory");
+  std::random_device rd;
+  // Built by appending: GCC 12 warns falsely (-Wrestrict) on "." + string.
+  std::string name = ".";
+  name += target.filename().string();
+  name += ".tmp" + std::to_string(getpid()) + "-" + std::to_string(rd());
+  const std::filesystem::path temp = target.parent_path() / name;
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    throwBadInput(path.string() + ": cannot write (" + std::strerror(errno) + ")");
+  }
+  auto abandon = [&](const std::string& why) {
+    ::close(fd);
+    std::filesystem::remove(temp, ec);
+    throwBadInput(path.string() + ": " + why);
+  };
+  const char* data = content.data();
+  std::size_t left = content.size();
+  while (left > 0) {
+    const ssize_t written = ::write(fd, data, left);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      abandon(std::string("write failed (") + std::strerror(errno) + ")");
     }
+    data += written;
+    left -= static_cast<std::size_t>(written);
   }
-  std::ostringstream stream;
-  if (!OpenMesh::IO::write_mesh(om, stream, lowerExtension(path), OpenMesh::IO::Options::Default, 17)) {
-    throwBadInput(path.string() + ": mesh could not be encoded");
+  // On disk before the rename, so that a crash cannot leave an empty file in place of the old one.
+  if (::fsync(fd) != 0) abandon(std::string("write failed (") + std::strerror(errno) + ")");
+  if (::close(fd) != 0) {
+    std::filesystem::remove(temp, ec);
+    throwBadInput(path.string() + ": write failed (" + std::strerror(errno) + ")");
   }
-  writeFileAtomically(path, stream.str());
+  std::filesystem::rename(temp, target, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    throwBadInput(path.string() + ": cannot replace file: " + ec.message());
+  }
 }
 
 }  // namespace plano

@@ -286,7 +286,10 @@ void checkDuplicateFaces(Context& ctx) {
   for (std::size_t i = 1; i < order.size(); ++i) {
     const auto a = key(order[i - 1]), b = key(order[i]);
     if (a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin())) {
-      // stable_sort keeps equal faces in increasing order: name the later one.
+      // stable_sort keeps equal faces in increasing order: name the later one, and leave
+      // it out of the edge checks (its edges would all look non-manifold or misoriented).
+      // Its vertices keep their fans: the first copy is still there.
+      ctx.brokenFace[order[i]] = 1;
       ctx.issues.add(ValidationIssueKind::DuplicateFace, Severity::Error, order[i], -1, [&] {
         return std::string("face " + str(order[i]) + " duplicates face " + str(order[i - 1]) + " (same vertices)");
       });
@@ -335,15 +338,18 @@ ValidationReport validate(const PolygonMesh& mesh, const ValidationSettings& set
   Context ctx{mesh, settings, issues, {}, {}, {}};
   checkCoordinates(ctx);
   checkFaceStructure(ctx);
+  checkDuplicateFaces(ctx);
   checkEdgesAndFans(ctx);
   checkFaceGeometry(ctx);
-  checkDuplicateFaces(ctx);
   checkIsolatedVertices(ctx);
   return issues.finish();
 }
 
 void requireValid(const PolygonMesh& mesh, const std::string& source, const ValidationSettings& settings) {
-  const ValidationReport report = validate(mesh, settings);
+  requireValid(validate(mesh, settings), source);
+}
+
+void requireValid(const ValidationReport& report, const std::string& source) {
   if (report.valid()) return;
   constexpr std::size_t kShown = 3;
   std::string message = source + ": ";

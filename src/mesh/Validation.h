@@ -93,4 +93,7 @@ ValidationReport validate(const PolygonMesh& mesh, const ValidationSettings& set
 /// "mesh.obj: face 3 repeats vertex 7; vertex 9: coordinate x is NaN (and 4 more errors)".
 void requireValid(const PolygonMesh& mesh, const std::string& source, const ValidationSettings& settings = {});
 
+/// Throw Error(BadInput) as above when `report` has an error.
+void requireValid(const ValidationReport& report, const std::string& source);
+
 }  // namespace plano

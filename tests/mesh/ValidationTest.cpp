@@ -201,6 +201,7 @@ TEST(Validation, ReportsDuplicateFace) {
   const auto* issue = findIssue(report, ValidationIssueKind::DuplicateFace);
   ASSERT_NE(issue, nullptr);
   EXPECT_EQ(issue->message, "face 6 duplicates face 1 (same vertices)");
+  EXPECT_EQ(report.errorCount, 1u);  // its shared edges are not reported a second time
 }
 
 TEST(Validation, IsolatedVertexIsOnlyAWarning) {

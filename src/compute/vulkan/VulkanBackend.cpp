@@ -2,7 +2,9 @@
 
 #include "compute/cpu/CpuBackend.h"
 #include "compute/vulkan/VulkanContext.h"
+#include "compute/vulkan/VulkanClosestRotations.h"
 #include "compute/vulkan/VulkanFacePlanarity.h"
+#include "compute/vulkan/VulkanProjectiveFit.h"
 #include "core/Error.h"
 
 namespace plano::compute {
@@ -21,16 +23,19 @@ void VulkanBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out
   planarity_->run(mesh, out);
 }
 
-// Not yet ported to the device: the CPU reference computes these.
 void VulkanBackend::fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
                                       ProjectiveFits& out) {
-  CpuBackend().fitProjectiveMaps(faces, source, target, out);
+  if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
+  projectiveFit_->run(faces, source, target, out);
 }
 
 void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                                      std::span<Eigen::Vector3d> singularValues) {
-  CpuBackend().closestRotations(matrices, rotations, singularValues);
+  if (!rotations_) rotations_ = std::make_unique<vk::ClosestRotationsKernel>(*context_);
+  rotations_->run(matrices, rotations, singularValues);
 }
+
+// Not yet ported to the device: the CPU reference solves.
 
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
   return CpuBackend().createSpdSolver(A, settings);

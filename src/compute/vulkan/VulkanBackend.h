@@ -8,6 +8,8 @@
 namespace plano::vk {
 class Context;
 class FacePlanarityKernel;
+class ProjectiveFitKernel;
+class ClosestRotationsKernel;
 }  // namespace plano::vk
 
 namespace plano::compute {
@@ -39,6 +41,8 @@ class VulkanBackend final : public Backend {
  private:
   std::unique_ptr<vk::Context> context_;
   std::unique_ptr<vk::FacePlanarityKernel> planarity_;
+  std::unique_ptr<vk::ProjectiveFitKernel> projectiveFit_;
+  std::unique_ptr<vk::ClosestRotationsKernel> rotations_;
 };
 
 /// Create the Vulkan backend. The device can be forced with the environment variable

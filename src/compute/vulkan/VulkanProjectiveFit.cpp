@@ -1,0 +1,105 @@
+#include "compute/vulkan/VulkanProjectiveFit.h"
+
+#include <algorithm>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct Push {
+  std::uint32_t firstFace;
+  std::uint32_t faceCount;
+  double rankThreshold;
+};
+
+static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 16 packed doubles");
+static_assert(sizeof(int) == sizeof(std::int32_t), "ranks are 32-bit on the device");
+
+constexpr std::size_t kMapBytes = 16 * sizeof(double);
+// shaders/projective_fit.comp: FIT_GROUP_SIZE invocations, each with 225 + 3 * 15 + 16
+// doubles and 15 ints of shared memory.
+constexpr std::uint32_t kFitGroupSize = 8;
+constexpr std::size_t kSharedBytes = kFitGroupSize * ((225 + 3 * 15 + 16) * sizeof(double) + 15 * sizeof(int));
+
+void checkSharedMemory(const Context& context) {
+  if (context.info().maxSharedMemoryBytes < kSharedBytes) {
+    throwDevice("Vulkan: projective fits need " + std::to_string(kSharedBytes) + " bytes of shared memory per " +
+                "workgroup, device '" + context.info().name + "' offers " +
+                std::to_string(context.info().maxSharedMemoryBytes));
+  }
+}
+
+}  // namespace
+
+ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings settings)
+    : context_(context), settings_(settings), pipeline_((checkSharedMemory(context), context), "projective_fit", 8,
+                                                       sizeof(Push)) {}
+
+void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
+                              compute::ProjectiveFits& out) {
+  if (source.rows() != target.rows()) {
+    throwUsage("fitProjectiveMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
+               std::to_string(target.rows()));
+  }
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  out.maps.resize(faceCount);
+  out.reciprocalScales.resize(faces.cornerCount());
+  out.residuals.resize(faceCount);
+  out.ranks.resize(faceCount);
+  if (faceCount == 0) return;
+
+  const std::size_t range = context_.info().maxStorageBufferRange;
+  const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
+  if (positionBytes > range || faces.indices().size() * sizeof(Index) > range) {
+    throwDevice("Vulkan: the mesh (" + std::to_string(source.rows()) + " vertices, " +
+                std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
+                std::to_string(range) + " bytes; use the CPU backend");
+  }
+  Array<double> sourceBuffer(context_, source.size(), MemoryClass::Device, "source positions");
+  sourceBuffer.upload({source.data(), static_cast<std::size_t>(source.size())});
+  Array<double> targetBuffer(context_, target.size(), MemoryClass::Device, "target positions");
+  targetBuffer.upload({target.data(), static_cast<std::size_t>(target.size())});
+  Array<Index> offsets(context_, faces.offsets().size(), MemoryClass::Device, "face offsets");
+  offsets.upload(faces.offsets());
+  Array<Index> indices(context_, faces.indices().size(), MemoryClass::Device, "face corners");
+  indices.upload(faces.indices());
+
+  // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
+  // fit one storage binding.
+  const std::vector<Index>& offset = faces.offsets();
+  const std::size_t maxFaces = std::min(faceCount, range / kMapBytes);
+  std::size_t maxCorners = 0;
+  for (std::size_t first = 0; first < faceCount;) {
+    std::size_t last = std::min(faceCount, first + maxFaces);
+    while (static_cast<std::size_t>(offset[last] - offset[first]) * sizeof(double) > range) --last;
+    maxCorners = std::max<std::size_t>(maxCorners, offset[last] - offset[first]);
+    first = last;
+  }
+  Buffer maps(context_, maxFaces * kMapBytes, MemoryClass::Device, "projective maps");
+  Array<double> scales(context_, maxCorners, MemoryClass::Device, "reciprocal scales");
+  Array<double> residuals(context_, maxFaces, MemoryClass::Device, "fit residuals");
+  Array<std::int32_t> ranks(context_, maxFaces, MemoryClass::Device, "fit ranks");
+  DescriptorSet set(context_, pipeline_,
+                    {sourceBuffer, targetBuffer, offsets, indices, maps, scales, residuals, ranks});
+  Sequence sequence(context_);
+  for (std::size_t first = 0; first < faceCount;) {
+    std::size_t last = std::min(faceCount, first + maxFaces);
+    while (static_cast<std::size_t>(offset[last] - offset[first]) * sizeof(double) > range) --last;
+    const std::size_t n = last - first;
+    sequence.begin();
+    sequence.dispatch(pipeline_, set,
+                      Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), settings_.rankThreshold},
+                      groupsFor(context_, n, kFitGroupSize));
+    sequence.end();
+    sequence.run();
+    maps.download(out.maps.data() + first, n * kMapBytes);
+    scales.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
+    residuals.download(std::span<double>(out.residuals).subspan(first, n));
+    ranks.download(std::span<std::int32_t>(out.ranks.data() + first, n));
+    first = last;
+  }
+}
+
+}  // namespace plano::vk

@@ -1,0 +1,32 @@
+#pragma once
+// Batched projective fits (projective-maps paper §4.1, Eq. 3) on the device:
+// shaders/projective_fit.comp, the math of src/projective/LocalFit.cpp, one invocation
+// per face, fp64.
+#include "compute/Backend.h"
+#include "compute/vulkan/VulkanSequence.h"
+
+namespace plano::vk {
+
+struct ProjectiveFitSettings {
+  /// Singular values below rankThreshold * the largest count as zero (the CPU reference's
+  /// complete orthogonal decomposition uses the same relative threshold on its pivots).
+  double rankThreshold = 1e-10;
+};
+
+class ProjectiveFitKernel {
+ public:
+  explicit ProjectiveFitKernel(Context& context, ProjectiveFitSettings settings = {});
+
+  /// The map of every face from `source` to `target` corners (both #V x 3) into `out`
+  /// (maps, reciprocal scales per corner in CSR order, RMS residuals, ranks). Throws
+  /// Error(Usage) when the position arrays differ in size, Error(Device) when the
+  /// positions exceed the device's storage-buffer range.
+  void run(const FaceList& faces, const Positions& source, const Positions& target, compute::ProjectiveFits& out);
+
+ private:
+  Context& context_;
+  ProjectiveFitSettings settings_;
+  Pipeline pipeline_;
+};
+
+}  // namespace plano::vk

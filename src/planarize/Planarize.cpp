@@ -1,0 +1,45 @@
+#include "planarize/Planarize.h"
+
+#include "core/Error.h"
+#include "planarize/AndersonPlanarizer.h"
+#include "planarize/GaussNewtonPlanarizer.h"
+#include "planarize/ShapeUpPlanarizer.h"
+
+namespace plano::planarize {
+
+Method parseMethod(const std::string& text) {
+  if (text == "shapeup") return Method::ShapeUp;
+  if (text == "anderson") return Method::Anderson;
+  if (text == "gauss-newton") return Method::GaussNewton;
+  throwUsage("unknown planarization method '" + text + "' (use shapeup, anderson or gauss-newton)");
+}
+
+const char* toString(Method method) {
+  switch (method) {
+    case Method::ShapeUp: return "shapeup";
+    case Method::Anderson: return "anderson";
+    case Method::GaussNewton: return "gauss-newton";
+  }
+  return "unknown";
+}
+
+const char* toString(Status status) {
+  switch (status) {
+    case Status::Converged: return "converged";
+    case Status::IterationLimit: return "iteration_limit";
+    case Status::Stalled: return "stalled";
+  }
+  return "unknown";
+}
+
+Info planarize(const FaceList& faces, Positions& vertices, const Settings& settings, compute::Backend& backend) {
+  const Positions input = vertices;
+  switch (settings.method) {
+    case Method::ShapeUp: return ShapeUpPlanarizer(faces, input, settings, backend).solve(vertices);
+    case Method::Anderson: return AndersonPlanarizer(faces, input, settings, backend).solve(vertices);
+    case Method::GaussNewton: return GaussNewtonPlanarizer(faces, input, settings, backend).solve(vertices);
+  }
+  throwUsage("planarize: unknown method");
+}
+
+}  // namespace plano::planarize

@@ -1,0 +1,57 @@
+#include "planarize/ShapeUpPlanarizer.h"
+
+#include <chrono>
+
+#include "planarize/Monitor.h"
+#include "planarize/Problem.h"
+#include "planarize/ShapeUpStep.h"
+
+namespace plano::planarize {
+namespace {
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+}  // namespace
+
+ShapeUpPlanarizer::ShapeUpPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
+                                     compute::Backend& backend)
+    : settings_(settings), backend_(&backend) {
+  const auto start = Clock::now();
+  problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
+  step_ = std::make_unique<detail::ShapeUpStep>(*problem_, settings.closeness, backend);
+  precomputeSeconds_ = secondsSince(start);
+}
+
+ShapeUpPlanarizer::~ShapeUpPlanarizer() = default;
+
+Info ShapeUpPlanarizer::solve(Positions& vertices) {
+  const auto start = Clock::now();
+  const detail::Problem& problem = *problem_;
+  Positions Y = detail::toNormalized(problem, vertices);
+  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
+    if (problem.freeIndex[v] < 0) Y.row(v) = problem.input.row(v);
+  }
+  Info info;
+  detail::Monitor monitor(problem, *backend_, settings_.tolerance);
+  bool converged = monitor.record(Y, info);
+  Positions previous;
+  while (!converged && info.iterations < settings_.maxIterations) {
+    previous = Y;
+    step_->project(Y);
+    step_->globalStep(Y);
+    ++info.iterations;
+    info.linearResidual = std::max(info.linearResidual, step_->linearResidual());
+    converged = monitor.record(Y, info);
+    // Stalled: the fixed point of the closeness-weighted energy is above the tolerance.
+    if (!converged && (Y - previous).cwiseAbs().maxCoeff() < 1e-12) {
+      info.status = Status::Stalled;
+      break;
+    }
+  }
+  if (converged) info.status = Status::Converged;
+  detail::measureDisplacement(problem, Y, info);
+  vertices = detail::toOriginal(problem, Y);
+  info.seconds = precomputeSeconds_ + secondsSince(start);
+  return info;
+}
+
+}  // namespace plano::planarize

@@ -1,0 +1,93 @@
+#pragma once
+// OSQP-style ADMM for the convex quadratic programs of the global step (projective-maps
+// paper, Eq. 4 with the ε relaxation of §4.2):
+//
+//   minimize  sum_c 1/2 x_c^T P x_c + q_c^T x_c   subject to  l_c <= C x_c <= u_c,
+//
+// for k independent columns x_c that share P (n x n, symmetric positive definite) and C
+// (m x n) and differ in q, l and u. The iteration follows OSQP (Stellato et al. 2020):
+// the only linear system is K = P + sigma I + C^T diag(rho) C, solved through
+// Backend::createSpdSolver (prefactored CHOLMOD on the CPU, PCG on a GPU), one solve for
+// all k columns; rows with l = u get a 1e3 times stiffer rho, as in OSQP. rho adapts to
+// the ratio of the residuals (K is refactored only when rho changes by more than
+// `adaptiveRhoFactor`); a converged solution is polished by re-solving with the active
+// bounds as equalities, which removes the ADMM's residual tolerance from the answer.
+#include <Eigen/Core>
+#include <memory>
+
+#include "compute/Backend.h"
+
+namespace plano::projective {
+
+struct BoxQpSettings {
+  double rho = 0.1;                  ///< Initial ADMM penalty of inequality rows.
+  double equalityRhoScale = 1e3;     ///< rho of rows with l = u, relative to rho.
+  double sigma = 1e-6;               ///< Proximal term: keeps K definite for a PSD P.
+  double relaxation = 1.6;           ///< Over-relaxation alpha in (0, 2).
+  double absoluteTolerance = 1e-6;   ///< eps_abs of the primal and dual residuals (inf-norms).
+  double relativeTolerance = 1e-6;   ///< eps_rel, relative to the sizes of the terms.
+  double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
+  int maxIterations = 4000;
+  int checkInterval = 10;            ///< Residuals and certificates every this many iterations.
+  bool adaptiveRho = true;
+  double adaptiveRhoFactor = 5.0;    ///< Refactor only when rho moves by more than this factor.
+  bool polish = true;
+  int polishIterations = 8;          ///< Method-of-multipliers refinements of the polish.
+  double polishRho = 1e6;            ///< Penalty of the polish's equality system.
+  compute::LinearSolverSettings linearSolver;
+};
+
+enum class BoxQpStatus {
+  Solved,               ///< Primal and dual residuals below their tolerances.
+  PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
+  MaxIterationsReached, ///< Neither converged nor proven infeasible.
+  NonFinite,            ///< NaN or Inf appeared in the iteration.
+};
+
+const char* toString(BoxQpStatus status);
+
+struct BoxQpInfo {
+  BoxQpStatus status = BoxQpStatus::MaxIterationsReached;
+  int iterations = 0;            ///< ADMM iterations.
+  int factorizations = 0;        ///< Factorizations of K (1 + rho updates).
+  double primalResidual = 0.0;   ///< ||C x - z||_inf (max over columns), after polishing.
+  double dualResidual = 0.0;     ///< ||P x + q + C^T y||_inf before polishing.
+  double maxBoundViolation = 0.0;  ///< max(l - Cx, Cx - u, 0) over all rows and columns.
+  double rho = 0.0;              ///< Final rho.
+  bool polished = false;         ///< The polished solution was accepted.
+};
+
+class BoxQpSolver {
+ public:
+  /// Precompute: keeps P (n x n) and C (m x n); K is factored on the first solve.
+  BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, compute::SparseMatrix C,
+              const BoxQpSettings& settings = {});
+
+  /// Solve for k columns at once.
+  ///   q     in: n x k linear terms.
+  ///   lower, upper  in: m x k bounds (lower <= upper; equal for equality rows).
+  ///   x     in/out: n x k, warm start on entry (zero if empty), solution on exit.
+  ///   y     in/out: m x k dual variables, warm start on entry (zero if empty).
+  /// Rows whose bounds are equal in every column are equality rows. K is refactored when
+  /// the equality pattern or rho changed since the last solve.
+  BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                  Eigen::MatrixXd& x, Eigen::MatrixXd& y);
+
+  const BoxQpSettings& settings() const { return settings_; }
+
+ private:
+  void factor(const Eigen::VectorXd& rhoPerRow);
+  bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+              const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
+
+  compute::Backend& backend_;
+  BoxQpSettings settings_;
+  compute::SparseMatrix P_;
+  compute::SparseMatrix C_;
+  compute::SparseMatrix Ct_;
+  std::unique_ptr<compute::SpdSolver> solver_;
+  Eigen::VectorXd factoredRho_;  ///< rho per row of the current factorization.
+  double rho_ = 0.1;
+};
+
+}  // namespace plano::projective

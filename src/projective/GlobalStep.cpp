@@ -1,0 +1,209 @@
+#include "projective/GlobalStep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_set>
+
+#include "core/Error.h"
+
+namespace plano::projective {
+namespace {
+
+/// Below this |shat| a corner is mapped (numerically) to the plane at infinity.
+constexpr double kMinimumReciprocalScale = 1e-10;
+
+std::string formatDouble(double value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+}  // namespace
+
+const char* toString(GlobalStepStatus status) {
+  switch (status) {
+    case GlobalStepStatus::Solved: return "solved";
+    case GlobalStepStatus::Unchanged: return "unchanged";
+  }
+  return "unknown";
+}
+
+GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> constrained,
+                       const GlobalStepSettings& settings)
+    : backend_(backend), space_(space), constrained_(std::move(constrained)), settings_(settings),
+      rho_(settings.qp.rho) {
+  if (!(settings_.smoothness >= 0.0) || !std::isfinite(settings_.smoothness)) {
+    throwUsage("global step: smoothness must be a finite number >= 0, got " + formatDouble(settings_.smoothness));
+  }
+  if (!(settings_.epsilonGrowth > 1.0)) throwUsage("global step: epsilon growth must exceed 1");
+  std::vector<Index> slot(space_.vertexCount(), -1);
+  for (std::size_t i = 0; i < constrained_.size(); ++i) {
+    const Index v = constrained_[i];
+    if (v < 0 || v >= space_.vertexCount()) {
+      throwBadInput("global step: constrained vertex " + std::to_string(v) + " is out of range (" +
+                    std::to_string(space_.vertexCount()) + " vertices)");
+    }
+    if (slot[v] >= 0) throwBadInput("global step: vertex " + std::to_string(v) + " is constrained twice");
+    slot[v] = static_cast<Index>(i);
+  }
+
+  const auto& offsets = space_.vertexCornerOffsets();
+  const auto& corners = space_.cornersOfVertex();
+  for (Index v = 0; v < space_.vertexCount(); ++v) {
+    const Index begin = offsets[v];
+    const Index end = offsets[v + 1];
+    if (slot[v] >= 0) {
+      for (Index k = begin; k < end; ++k) rows_.push_back({v, corners[k], -1, slot[v]});
+    } else {
+      for (Index k = begin + 1; k < end; ++k) rows_.push_back({v, corners[begin], corners[k], -1});
+    }
+  }
+
+  // P = I + alpha * (L kron I_4): ||A_f - A_g||^2 per column adds alpha to the (f, f),
+  // (g, g) blocks and -alpha to the (f, g), (g, f) blocks of each of the 4 entries.
+  const Index n = 4 * space_.faceCount();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<std::size_t>(n) + 16 * space_.adjacentFaces().size());
+  for (Index i = 0; i < n; ++i) entries.emplace_back(i, i, 1.0);
+  const double alpha = settings_.smoothness;
+  if (alpha > 0.0) {
+    for (const auto& [f, g] : space_.adjacentFaces()) {
+      for (Index r = 0; r < 4; ++r) {
+        entries.emplace_back(4 * f + r, 4 * f + r, alpha);
+        entries.emplace_back(4 * g + r, 4 * g + r, alpha);
+        entries.emplace_back(4 * f + r, 4 * g + r, -alpha);
+        entries.emplace_back(4 * g + r, 4 * f + r, -alpha);
+      }
+    }
+  }
+  P_.resize(n, n);
+  P_.setFromTriplets(entries.begin(), entries.end());
+}
+
+GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, const Positions& positions,
+                                 FaceMaps& result) {
+  const Index faceCount = space_.faceCount();
+  if (static_cast<Index>(targets.size()) != faceCount) {
+    throwUsage("global step: " + std::to_string(targets.size()) + " target maps for " + std::to_string(faceCount) +
+               " faces");
+  }
+  if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
+    throwUsage("global step: " + std::to_string(positions.rows()) + " positions for " +
+               std::to_string(constrained_.size()) + " constrained vertices");
+  }
+  for (Index f = 0; f < faceCount; ++f) {
+    if (!targets[f].allFinite()) throwNumerical("global step: the target map of face " + std::to_string(f) + " is not finite");
+  }
+
+  GlobalStepInfo info;
+  const std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  for (Index c = 0; c < space_.cornerCount(); ++c) {
+    if (shat[c] <= 0.0) ++info.nonPositiveScales;
+    if (!(std::abs(shat[c]) > kMinimumReciprocalScale)) {
+      throwNumerical("global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
+                     " sends vertex " + std::to_string(space_.faces().indices()[c]) +
+                     " to infinity (reciprocal scale factor " + formatDouble(shat[c]) + ")");
+    }
+  }
+
+  // C_s and d for columns 0..2 (d differs per column only on positional rows).
+  const auto m = static_cast<Eigen::Index>(rows_.size());
+  const Index n = 4 * faceCount;
+  const Positions& base = space_.basePositions();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(rows_.size() * 8);
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
+  std::vector<char> positional(m, 0);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Row& row = rows_[r];
+    const Eigen::RowVector4d p = homogeneous(base.row(row.vertex));
+    const Index fa = space_.cornerFace(row.cornerA);
+    for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fa + k, p[k] / shat[row.cornerA]);
+    if (row.cornerB >= 0) {
+      const Index fb = space_.cornerFace(row.cornerB);
+      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fb + k, -p[k] / shat[row.cornerB]);
+    } else {
+      positional[r] = 1;
+      const Eigen::RowVector3d q = space_.normalization().toNormalized(Eigen::RowVector3d(positions.row(row.constrainedSlot)));
+      if (!q.allFinite()) {
+        throwBadInput("global step: the position of constrained vertex " + std::to_string(row.vertex) + " is not finite");
+      }
+      d.row(r) = q;
+    }
+  }
+  compute::SparseMatrix C(m, n);
+  C.setFromTriplets(entries.begin(), entries.end());
+
+  Eigen::MatrixXd T(n, 3);
+  for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
+  const Eigen::MatrixXd q = -T;
+  info.initialViolation = m > 0 ? (C * T - d).cwiseAbs().maxCoeff() : 0.0;
+
+  std::vector<double> schedule;
+  const double eps0 = settings_.initialEpsilonFraction * info.initialViolation;
+  if (settings_.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
+  if (eps0 > 0.0) {
+    double eps = eps0;
+    for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
+  }
+
+  BoxQpSettings qpSettings = settings_.qp;
+  qpSettings.rho = rho_;
+  BoxQpSolver qp(backend_, P_, C, qpSettings);
+  Eigen::MatrixXd x = T;
+  bool solved = false;
+  for (double eps : schedule) {
+    Eigen::MatrixXd lower = d;
+    Eigen::MatrixXd upper = d;
+    for (Eigen::Index r = 0; r < m; ++r) {
+      if (!positional[r]) {
+        lower.row(r).array() -= eps;
+        upper.row(r).array() += eps;
+      }
+    }
+    // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
+    // (its certificate), a poor warm start for the next eps.
+    Eigen::MatrixXd xTry = T;
+    Eigen::MatrixXd yTry;
+    const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
+    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
+    info.admmIterations += qpInfo.iterations;
+    info.factorizations += qpInfo.factorizations;
+    rho_ = qpInfo.rho;
+    if (qpInfo.status == BoxQpStatus::NonFinite) {
+      throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
+    }
+    if (qpInfo.status == BoxQpStatus::Solved) {
+      x = xTry;
+      info.epsilon = eps;
+      info.polished = qpInfo.polished;
+      info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
+      solved = true;
+      break;
+    }
+  }
+  if (!solved) {
+    throwNumerical("global step: no feasible relaxation found; eps grew from " + formatDouble(schedule.front()) +
+                   " to " + formatDouble(schedule.back()) + " (initial violation " +
+                   formatDouble(info.initialViolation) + ", " + std::to_string(info.admmIterations) +
+                   " ADMM iterations)");
+  }
+
+  const Eigen::MatrixXd residual = m > 0 ? Eigen::MatrixXd((C * x - d).cwiseAbs()) : Eigen::MatrixXd();
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const double value = residual.row(r).maxCoeff();
+    info.constraintResidual = std::max(info.constraintResidual, value);
+    if (positional[r]) info.positionalResidual = std::max(info.positionalResidual, value);
+  }
+
+  result.maps.resize(faceCount);
+  for (Index f = 0; f < faceCount; ++f) {
+    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
+    result.maps[f].col(3) = targets[f].col(3);
+  }
+  result.reciprocalScales = shat;
+  return info;
+}
+
+}  // namespace plano::projective

@@ -1,0 +1,119 @@
+#pragma once
+// Global step of the projective-maps paper (§4.2, Eq. 4, with the smoothness term of
+// §6.3): the compatible face maps closest to prescribed maps T_f,
+//
+//   minimize  sum_f ||A_f - T_f||_F^2 + alpha sum_{f,g adjacent} ||A_f - A_g||_F^2
+//   subject to  d - eps <= C_s A <= d + eps   (compatibility, Eq. 2)
+//               s_{f,i} (p_i, 1) A_f = (q_i, 1)  (positional: fixed vertices and handles)
+//
+// with the scale factors s_{f,i} = 1 / ((p_i, 1) T_f[:, 3]) induced by the targets and
+// held fixed, which makes the problem convex (§4.2).
+//
+// Structure used (see notes on the framework): with those scale factors the fourth
+// columns of the targets already satisfy every row (all weights are 1), and with
+// A(3, 3) = 1 fixed they are the only choice on a face whose plane misses the origin
+// (normalized coordinates make this the rule), so A_f[:, 3] = T_f[:, 3]. Columns 0..2 are
+// three independent QPs with one matrix: one factorization, three right-hand sides.
+//
+// Compatibility rows: at every unconstrained vertex, the image of its first corner's face
+// minus the image of each other corner's face, coordinate-wise, so the row value is a
+// position difference in normalized units. At a constrained vertex, every incident face
+// gets a positional row instead (which implies compatibility there); positional rows are
+// never relaxed.
+//
+// The ε schedule is the paper's (§5): eps_0 = 1e-2 max|C_s T - d|, multiplied by 10
+// until the relaxed problem is feasible, where feasible means: the ADMM (BoxQp.h)
+// converged to its primal and dual tolerances. A proven-infeasible or unconverged attempt
+// moves on to the next eps; after `maxEpsilonIncreases` increases, Error(Numerical).
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "compute/Backend.h"
+#include "projective/BoxQp.h"
+#include "projective/ShapeSpace.h"
+
+namespace plano::projective {
+
+enum class EpsilonStart {
+  Relaxed,     ///< The paper: first eps = initialEpsilonFraction * initial violation.
+  ExactFirst,  ///< Try eps = 0 first (exactly compatible maps, exactly planar faces).
+};
+
+struct GlobalStepSettings {
+  double smoothness = 0.0;  ///< alpha of §6.3 (the paper uses 3..4 after prolongation).
+  EpsilonStart epsilonStart = EpsilonStart::Relaxed;
+  double initialEpsilonFraction = 1e-2;
+  double epsilonGrowth = 10.0;
+  int maxEpsilonIncreases = 8;
+  BoxQpSettings qp;
+};
+
+/// One eps of the schedule.
+struct EpsilonAttempt {
+  double epsilon = 0.0;
+  BoxQpStatus status = BoxQpStatus::MaxIterationsReached;
+  int iterations = 0;
+};
+
+enum class GlobalStepStatus {
+  Solved,      ///< The QP converged for `epsilon`.
+  Unchanged,   ///< The targets were already compatible and optimal (returned as given).
+};
+
+const char* toString(GlobalStepStatus status);
+
+struct GlobalStepInfo {
+  GlobalStepStatus status = GlobalStepStatus::Solved;
+  double epsilon = 0.0;              ///< The eps of the accepted solution.
+  double initialViolation = 0.0;     ///< max |C_s T - d| of the targets.
+  double constraintResidual = 0.0;   ///< max |C_s A - d| of the result (<= eps + tolerance).
+  double positionalResidual = 0.0;   ///< max |C_s A - d| over positional rows.
+  int admmIterations = 0;            ///< Summed over the attempts.
+  int factorizations = 0;
+  bool polished = false;
+  Index nonPositiveScales = 0;       ///< Corners with shat <= 0 (reported, not an error).
+  std::vector<EpsilonAttempt> attempts;
+};
+
+class GlobalStep {
+ public:
+  /// Precompute what depends only on the topology: P = I + alpha L (L the face-adjacency
+  /// Laplacian, per matrix entry) and the row layout.
+  ///   space        in: the shape space (kept by reference: must outlive this object).
+  ///   constrained  in: vertices with positional rows (fixed vertices and handles), unique.
+  /// Throws Error(BadInput) for an out-of-range or repeated vertex.
+  GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> constrained,
+             const GlobalStepSettings& settings = {});
+
+  /// Project the targets onto the compatible shape space.
+  ///   targets    in: #F maps T_f (normalized coordinates, T(3, 3) = 1).
+  ///   positions  in: #constrained x 3 world positions of the constrained vertices, in the
+  ///              order given to the constructor (ignored when there are none).
+  ///   result     out: the maps A_f and their reciprocal scales (those of the targets).
+  /// Throws Error(Numerical) when a target sends a corner to infinity (shat ~ 0), when the
+  /// iteration produces NaN, or when the eps schedule is exhausted.
+  GlobalStepInfo solve(const std::vector<Eigen::Matrix4d>& targets, const Positions& positions, FaceMaps& result);
+
+  const std::vector<Index>& constrainedVertices() const { return constrained_; }
+  const GlobalStepSettings& settings() const { return settings_; }
+
+ private:
+  /// One row of C_s: corner a's face minus corner b's face (b < 0: positional row).
+  struct Row {
+    Index vertex;
+    Index cornerA;
+    Index cornerB;
+    Index constrainedSlot;  ///< Index into constrained_ for positional rows, else -1.
+  };
+
+  compute::Backend& backend_;
+  const ShapeSpace& space_;
+  std::vector<Index> constrained_;
+  GlobalStepSettings settings_;
+  compute::SparseMatrix P_;
+  std::vector<Row> rows_;
+  double rho_;  ///< Carried from one solve to the next (the problems are alike).
+};
+
+}  // namespace plano::projective

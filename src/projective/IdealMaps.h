@@ -1,0 +1,40 @@
+#pragma once
+// Closest ideal maps of the projective-maps paper (App. A): the rigid or similarity map
+// closest to a fitted projective face map, the targets of as-rigid / as-similar-as-possible
+// deformation (§6.1).
+#include <Eigen/Core>
+#include <vector>
+
+#include "compute/Backend.h"
+#include "projective/ShapeSpace.h"
+
+namespace plano::projective {
+
+enum class IdealMapKind {
+  Rigid,    ///< Rotation + translation (orthogonal Procrustes).
+  Similar,  ///< Uniform scale * rotation + translation.
+};
+
+/// For every face f, the ideal map closest to the fitted projective map T_f.
+///
+/// A projective map is not affine, so it has no single linear part: we take its Jacobian
+/// J at the centroid c of the (plane-projected) source face, restricted to the face plane
+/// (the fit leaves the out-of-plane action arbitrary, "closest to the identity", which must
+/// not leak into the rotation). The 3x3 linear map L sends the source plane basis e1, e2
+/// to e1 J, e2 J and the source normal to the unit normal of their span, so L maps plane
+/// to plane and normal to normal and its closest rotation R (Backend::closestRotations) is
+/// the in-plane rotation of the fit. The similarity scale is the mean of the two
+/// singular values of the in-plane 2x2 map, s = (s1 + s2) / 2 = sqrt(|M|^2 + 2|det M|) / 2.
+/// The translation keeps the first-order expansion of the fit about the centroid:
+/// x -> phi(c) + (x - c) s R, with phi the dehomogenized fitted map.
+///
+///   backend  in: runs the batched Procrustes.
+///   space    in: base mesh (normalized coordinates).
+///   fitted   in: #F fitted maps T_f (normalized coordinates, row-vector convention).
+///   kind     in: rigid or similar.
+/// Returns #F affine maps [[s R, 0], [t, 1]] (row-vector convention, A(3, 3) = 1).
+/// Throws Error(Numerical) naming the face when its centroid maps to infinity.
+std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const ShapeSpace& space,
+                                              const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind);
+
+}  // namespace plano::projective

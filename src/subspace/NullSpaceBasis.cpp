@@ -1,0 +1,74 @@
+#include "subspace/NullSpaceBasis.h"
+
+#include <Eigen/Dense>
+#include <Eigen/SPQRSupport>
+
+#include "core/Error.h"
+
+namespace plano::subspace {
+namespace {
+
+Eigen::MatrixXd denseNullSpace(const compute::SparseMatrix& B, double tolerance, Index& rank) {
+  const Eigen::Index n = B.cols();
+  if (B.rows() == 0) {
+    rank = 0;
+    return Eigen::MatrixXd::Identity(n, n);
+  }
+  const Eigen::MatrixXd dense(B);
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(dense, Eigen::ComputeFullV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  const double cut = tolerance * std::max(s.size() ? s[0] : 0.0, 1e-300);
+  Eigen::Index r = 0;
+  while (r < s.size() && s[r] > cut) ++r;
+  rank = static_cast<Index>(r);
+  return svd.matrixV().rightCols(n - r);
+}
+
+Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance, Index& rank) {
+  using SpqrMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, SuiteSparse_long>;
+  const Eigen::Index n = B.cols();
+  if (B.rows() == 0) {
+    rank = 0;
+    return Eigen::MatrixXd::Identity(n, n);
+  }
+  // B^T P = Q R: the first rank(B) columns of Q span range(B^T), the others null(B).
+  const SpqrMatrix At = SpqrMatrix(B.transpose());
+  Eigen::SPQR<SpqrMatrix> qr;
+  double maxColumn = 0.0;
+  for (Eigen::Index j = 0; j < At.outerSize(); ++j) maxColumn = std::max(maxColumn, At.col(j).norm());
+  qr.setPivotThreshold(tolerance * std::max(maxColumn, 1e-300));
+  qr.compute(At);
+  if (qr.info() != Eigen::Success) throwNumerical("sparse QR of the constraint matrix failed");
+  rank = static_cast<Index>(qr.rank());
+  Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(n, n - rank);
+  selector.bottomRows(n - rank).setIdentity();
+  Eigen::MatrixXd N;
+  N = qr.matrixQ() * selector;
+  return N;
+}
+
+}  // namespace
+
+SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettings& settings, BasisInfo* info) {
+  const Index unknowns = static_cast<Index>(B.matrix.cols());
+  BasisMethod method = settings.method;
+  if (method == BasisMethod::Auto) method = unknowns <= settings.denseLimit ? BasisMethod::DenseSvd : BasisMethod::SparseQr;
+  Index rank = 0;
+  Eigen::MatrixXd N = method == BasisMethod::DenseSvd ? denseNullSpace(B.matrix, settings.rankTolerance, rank)
+                                                      : sparseNullSpace(B.matrix, settings.rankTolerance, rank);
+  if (!N.allFinite()) throwNumerical("null-space basis of the constraint matrix is not finite");
+  SubspaceBasis basis(std::move(N), B.separable);
+  if (info) {
+    info->method = method;
+    info->unknowns = unknowns;
+    info->rank = rank;
+    info->dimension = basis.dimension();
+    const Eigen::MatrixXd& C = basis.columns();
+    info->residual = C.cols() ? (B.matrix * C).cwiseAbs().maxCoeff() : 0.0;
+    info->orthogonality =
+        C.cols() ? (C.transpose() * C - Eigen::MatrixXd::Identity(C.cols(), C.cols())).cwiseAbs().maxCoeff() : 0.0;
+  }
+  return basis;
+}
+
+}  // namespace plano::subspace

@@ -1,0 +1,38 @@
+#pragma once
+// An orthonormal basis of null(B) (linear-spaces paper, §4 "Implementation details": a
+// sparse QR decomposition gives N; then every member of the space is N W).
+#include "subspace/ConstraintMatrix.h"
+#include "subspace/SubspaceBasis.h"
+
+namespace plano::subspace {
+
+enum class BasisMethod {
+  Auto,      ///< Dense SVD up to `denseLimit` unknowns, sparse QR above.
+  DenseSvd,  ///< SVD of the dense B: exact rank decisions, O(n^3); small meshes only.
+  SparseQr,  ///< SuiteSparseQR of B^T with column pivoting: rank-revealing in practice.
+};
+
+struct BasisSettings {
+  BasisMethod method = BasisMethod::Auto;
+  /// Rank tolerance: a singular value (SVD) or a pivot column norm (QR) of B below
+  /// rankTolerance * (largest one) counts as zero. B has orthonormal rows per face, so
+  /// its scale is 1 and this is also an absolute tolerance.
+  double rankTolerance = 1e-9;
+  /// Unknowns (#V when separable, else 3 #V) up to which Auto uses the dense SVD.
+  Index denseLimit = 600;
+};
+
+struct BasisInfo {
+  BasisMethod method = BasisMethod::Auto;  ///< The method that ran.
+  Index unknowns = 0;                      ///< Columns of the stored B.
+  Index rank = 0;                          ///< Numerical rank of the stored B.
+  Index dimension = 0;                     ///< dim null(B) of the full space.
+  double residual = 0.0;                   ///< max |B N| entry: how exactly the basis lies in null(B).
+  double orthogonality = 0.0;              ///< max |N^T N - I| entry.
+};
+
+/// Orthonormal basis of null(B). Throws Error(Numerical) when the factorization fails.
+SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettings& settings = {},
+                                    BasisInfo* info = nullptr);
+
+}  // namespace plano::subspace

@@ -1,0 +1,70 @@
+#include "subspace/SubspaceBasis.h"
+
+namespace plano::subspace {
+
+SubspaceBasis::SubspaceBasis(Eigen::MatrixXd columns, bool separable)
+    : columns_(std::move(columns)), separable_(separable) {}
+
+Index SubspaceBasis::dimension() const { return static_cast<Index>(columns_.cols()) * (separable_ ? 3 : 1); }
+
+Index SubspaceBasis::vertexCount() const { return static_cast<Index>(columns_.rows() / (separable_ ? 1 : 3)); }
+
+Positions SubspaceBasis::shape(const Eigen::VectorXd& w) const {
+  Positions X(vertexCount(), 3);
+  if (separable_) {
+    const Eigen::Index d1 = columns_.cols();
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Map<const Eigen::VectorXd, 0, Eigen::InnerStride<3>> wc(w.data() + c, d1);
+      X.col(c) = columns_ * wc;
+    }
+  } else {
+    Eigen::Map<Eigen::VectorXd>(X.data(), X.size()) = columns_ * w;
+  }
+  return X;
+}
+
+Eigen::VectorXd SubspaceBasis::coefficients(const Positions& X) const {
+  if (separable_) {
+    // W1 = N1^T X (d1 x 3), flattened row-major: coefficient 3 a + c.
+    const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> W1 = columns_.transpose() * X;
+    return Eigen::Map<const Eigen::VectorXd>(W1.data(), W1.size());
+  }
+  return columns_.transpose() * Eigen::Map<const Eigen::VectorXd>(X.data(), X.size());
+}
+
+Eigen::MatrixXd SubspaceBasis::reducedOperator(const compute::SparseMatrix& S) const {
+  if (separable_) {
+    const Eigen::MatrixXd R1 = columns_.transpose() * (S * columns_);
+    const Eigen::Index d1 = R1.rows();
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(3 * d1, 3 * d1);
+    for (Eigen::Index a = 0; a < d1; ++a)
+      for (Eigen::Index b = 0; b < d1; ++b)
+        for (int c = 0; c < 3; ++c) R(3 * a + c, 3 * b + c) = R1(a, b);
+    return R;
+  }
+  // (S (x) I_3) applied to each column viewed as a row-major #V x 3 matrix.
+  const Eigen::Index nv = vertexCount(), d = columns_.cols();
+  Eigen::MatrixXd SN(columns_.rows(), d);
+  for (Eigen::Index j = 0; j < d; ++j) {
+    const Eigen::Map<const Positions> Xj(columns_.col(j).data(), nv, 3);
+    Eigen::Map<Positions>(SN.col(j).data(), nv, 3) = S * Xj;
+  }
+  return columns_.transpose() * SN;
+}
+
+Eigen::MatrixXd SubspaceBasis::coordinateRows(std::span<const Index> coordinates) const {
+  const Eigen::Index n = static_cast<Eigen::Index>(coordinates.size());
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(n, dimension());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Index q = coordinates[i];
+    if (separable_) {
+      const Index v = q / 3, c = q % 3;
+      for (Eigen::Index a = 0; a < columns_.cols(); ++a) rows(i, 3 * a + c) = columns_(v, a);
+    } else {
+      rows.row(i) = columns_.row(q);
+    }
+  }
+  return rows;
+}
+
+}  // namespace plano::subspace

@@ -1,0 +1,46 @@
+#pragma once
+// An orthonormal basis N of a linear space of meshes (the null space of B), stored in the
+// compact form the space allows: for a separable space (every face affine) the scalar
+// basis N1 (#V x d1) with N = N1 (x) I_3, otherwise N itself (3 #V x d). Every algorithm
+// of src/subspace reaches N only through this class, so the separable case costs a third
+// of the memory and a ninth of the reduced-operator work.
+#include <Eigen/Core>
+#include <span>
+
+#include "compute/Backend.h"
+#include "mesh/PolygonMesh.h"
+
+namespace plano::subspace {
+
+class SubspaceBasis {
+ public:
+  SubspaceBasis() = default;
+  /// `columns`: N1 (#V x d1) when `separable`, else N (3 #V x d); orthonormal columns.
+  SubspaceBasis(Eigen::MatrixXd columns, bool separable);
+
+  /// d = dim of the space (3 d1 when separable).
+  Index dimension() const;
+  Index vertexCount() const;
+  bool separable() const { return separable_; }
+  /// The stored columns (N1 or N).
+  const Eigen::MatrixXd& columns() const { return columns_; }
+
+  /// The mesh N w (w has d entries). For a separable basis, coefficient 3 a + c moves
+  /// coordinate c along scalar column a.
+  Positions shape(const Eigen::VectorXd& w) const;
+  /// N^T vec(X): the coefficients of the orthogonal projection of X.
+  Eigen::VectorXd coefficients(const Positions& X) const;
+  /// N N^T vec(X): orthogonal projection of a mesh onto the space.
+  Positions project(const Positions& X) const { return shape(coefficients(X)); }
+
+  /// N^T (S (x) I_3) N for a scalar #V x #V operator S (d x d, dense).
+  Eigen::MatrixXd reducedOperator(const compute::SparseMatrix& S) const;
+  /// Rows of N for the full coordinates 3 v + c listed in `coordinates` (#coordinates x d).
+  Eigen::MatrixXd coordinateRows(std::span<const Index> coordinates) const;
+
+ private:
+  Eigen::MatrixXd columns_;
+  bool separable_ = false;
+};
+
+}  // namespace plano::subspace

@@ -1,0 +1,134 @@
+// Vulkan batched projective fits against the CPU reference (LocalFit): maps, reciprocal
+// scales, residuals and ranks to 1e-10 on well-conditioned faces.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "compute/VulkanFixture.h"
+#include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
+#include "mesh/Generators.h"
+#include "support/TestMeshes.h"
+
+namespace plano::test {
+namespace {
+
+struct FitComparison {
+  double maps = 0.0;       ///< Largest |difference| / max(1, |entry|) over map entries.
+  double scales = 0.0;     ///< Same for the reciprocal scales.
+  double residuals = 0.0;  ///< Largest absolute difference of RMS residuals.
+  int rankMismatches = 0;
+  Index faces = 0;
+  double largestResidual = 0.0;  ///< Of the CPU fits (to know an example is not trivial).
+};
+
+FitComparison compare(compute::Backend& backend, const FaceList& faces, const Positions& source,
+                      const Positions& target) {
+  compute::ProjectiveFits gpu, cpu;
+  backend.fitProjectiveMaps(faces, source, target, gpu);
+  compute::CpuBackend().fitProjectiveMaps(faces, source, target, cpu);
+  FitComparison c;
+  c.faces = faces.size();
+  for (Index f = 0; f < faces.size(); ++f) {
+    for (int e = 0; e < 16; ++e) {
+      const double a = gpu.maps[f].data()[e], b = cpu.maps[f].data()[e];
+      c.maps = std::max(c.maps, std::abs(a - b) / std::max(1.0, std::abs(b)));
+    }
+    c.residuals = std::max(c.residuals, std::abs(gpu.residuals[f] - cpu.residuals[f]));
+    c.largestResidual = std::max(c.largestResidual, cpu.residuals[f]);
+    if (gpu.ranks[f] != cpu.ranks[f]) ++c.rankMismatches;
+  }
+  for (std::size_t i = 0; i < cpu.reciprocalScales.size(); ++i) {
+    const double a = gpu.reciprocalScales[i], b = cpu.reciprocalScales[i];
+    c.scales = std::max(c.scales, std::abs(a - b) / std::max(1.0, std::abs(b)));
+  }
+  return c;
+}
+
+void expectAgreement(const FitComparison& c) {
+  EXPECT_LT(c.maps, 1e-10);
+  EXPECT_LT(c.scales, 1e-10);
+  EXPECT_LT(c.residuals, 1e-10);
+  EXPECT_EQ(c.rankMismatches, 0) << "of " << c.faces << " faces";
+}
+
+/// A projective map in the row-vector convention that keeps w > 0 on the unit box.
+Eigen::Matrix4d mildProjectiveMap() {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() * 1.2;
+  T.block<1, 3>(3, 0) << 0.1, -0.2, 0.05;  // translation
+  T.block<3, 1>(0, 3) << 0.08, -0.05, 0.03;  // perspective
+  return T;
+}
+
+Positions applyMap(const Positions& points, const Eigen::Matrix4d& T) {
+  Positions out(points.rows(), 3);
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Eigen::RowVector4d h = Eigen::RowVector4d(points(i, 0), points(i, 1), points(i, 2), 1.0) * T;
+    out.row(i) = h.head<3>() / h[3];
+  }
+  return out;
+}
+
+class VulkanProjectiveFit : public VulkanTest {};
+
+TEST_F(VulkanProjectiveFit, IdentityTargetGivesIdentityMapsOnPlanarQuads) {
+  const PolygonMesh mesh = generate::translationalSurface(6, 5);
+  compute::ProjectiveFits fits;
+  backend().fitProjectiveMaps(mesh.faces, mesh.vertices, mesh.vertices, fits);
+  for (Index f = 0; f < mesh.faceCount(); ++f) {
+    EXPECT_LT((fits.maps[f] - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff(), 1e-12) << "face " << f;
+  }
+  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, mesh.vertices));
+}
+
+TEST_F(VulkanProjectiveFit, MatchesCpuOnProjectivelyMappedQuads) {
+  const PolygonMesh mesh = generate::surfaceOfRevolution(12, 5, 0.5, 1.0);
+  const FitComparison c = compare(backend(), mesh.faces, mesh.vertices, applyMap(mesh.vertices, mildProjectiveMap()));
+  expectAgreement(c);
+}
+
+TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedQuads) {
+  // After projection onto their planes, four corners always admit an exact map.
+  const PolygonMesh mesh = generate::translationalSurface(5, 5);
+  const Positions target = perturbed(applyMap(mesh.vertices, mildProjectiveMap()), 0.02, 3);
+  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, target));
+}
+
+TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedHexagons) {
+  // Six corners over-determine a planar homography; the reference formulation then finds
+  // the degenerate exact fit with all reciprocal scales ~0, and both backends must agree.
+  const PolygonMesh dome = generate::hexagonalDome(3);
+  expectAgreement(compare(backend(), dome.faces, dome.vertices, perturbed(dome.vertices, 0.01, 9)));
+}
+
+TEST_F(VulkanProjectiveFit, MatchesCpuOnPentagonsAndHexagons) {
+  const PolygonMesh dodecahedron = generate::dodecahedron();
+  expectAgreement(compare(backend(), dodecahedron.faces, dodecahedron.vertices,
+                          perturbed(applyMap(dodecahedron.vertices, mildProjectiveMap()), 0.01, 5)));
+  const PolygonMesh dome = generate::hexagonalDome(3);
+  expectAgreement(compare(backend(), dome.faces, dome.vertices, applyMap(dome.vertices, mildProjectiveMap())));
+}
+
+TEST_F(VulkanProjectiveFit, MatchesCpuOnRandomTriangles) {
+  // Triangles are not projected (always planar) and give 9 equations in 15 unknowns.
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  PolygonMesh mesh;
+  mesh.vertices.resize(60, 3);
+  for (Index i = 0; i < mesh.vertices.size(); ++i) mesh.vertices.data()[i] = u(rng);
+  for (Index f = 0; f < 20; ++f) mesh.faces.addFace({3 * f, 3 * f + 1, 3 * f + 2});
+  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, perturbed(mesh.vertices, 0.05, 2)));
+}
+
+TEST_F(VulkanProjectiveFit, MismatchedPositionArraysAreAUsageError) {
+  const PolygonMesh mesh = generate::cube();
+  Positions fewer = mesh.vertices.topRows(4);
+  compute::ProjectiveFits fits;
+  EXPECT_THROW(backend().fitProjectiveMaps(mesh.faces, mesh.vertices, fewer, fits), Error);
+}
+
+}  // namespace
+}  // namespace plano::test

@@ -1,0 +1,151 @@
+#include "projective/GlobalStep.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
+#include "mesh/Generators.h"
+#include "mesh/Planarity.h"
+#include "projective/LocalStep.h"
+#include "projective/ProjectiveTestHelpers.h"
+#include "support/TestMeshes.h"
+
+namespace plano::projective {
+namespace {
+
+double maxMapDifference(const std::vector<Eigen::Matrix4d>& a, const std::vector<Eigen::Matrix4d>& b) {
+  double worst = 0.0;
+  for (std::size_t f = 0; f < a.size(); ++f) worst = std::max(worst, (a[f] - b[f]).cwiseAbs().maxCoeff());
+  return worst;
+}
+
+double maxPlanarity(const Positions& vertices, const FaceList& faces) {
+  return planarityStats(PolygonMesh{vertices, faces}).max;
+}
+
+/// Targets that disagree: the identity on half of the faces, a rotation about the
+/// z-axis on the others.
+std::vector<Eigen::Matrix4d> conflictingTargets(const ShapeSpace& space) {
+  std::vector<Eigen::Matrix4d> targets(space.faceCount(), Eigen::Matrix4d::Identity());
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (Index f = 0; f < space.faceCount(); f += 2) targets[f].topLeftCorner<3, 3>() = R;
+  return targets;
+}
+
+class GlobalStepTest : public ::testing::Test {
+ protected:
+  compute::CpuBackend backend;
+};
+
+TEST_F(GlobalStepTest, CompatibleMapsComeBackUnchangedInOneStep) {
+  for (const PolygonMesh& mesh : {generate::translationalSurface(6, 5), generate::hexagonalDome(2)}) {
+    const ShapeSpace space(mesh);
+    const Positions target =
+        space.normalization().toWorld(test::applyProjectiveMap(space.basePositions(), test::samplePerspective()));
+    const LocalStepResult fit = fitFaceMaps(backend, space, target);
+    GlobalStep global(backend, space, {});
+    FaceMaps result;
+    const GlobalStepInfo info = global.solve(fit.fits.maps, Positions(), result);
+    EXPECT_EQ(info.status, GlobalStepStatus::Unchanged);
+    EXPECT_EQ(info.admmIterations, 0);
+    EXPECT_LT(maxMapDifference(result.maps, fit.fits.maps), 1e-14);
+    EXPECT_LT(test::maxAbsDifference(space.positions(result.maps), target), 1e-10);
+  }
+}
+
+TEST_F(GlobalStepTest, IdentityTargetsGiveTheIdentity) {
+  const ShapeSpace space(generate::surfaceOfRevolution(8, 4));
+  const std::vector<Index> fixed = {0, 5, 17};
+  Positions at(3, 3);
+  for (int i = 0; i < 3; ++i) at.row(i) = space.baseMesh().vertices.row(fixed[i]);
+  GlobalStep global(backend, space, fixed);
+  FaceMaps result;
+  const GlobalStepInfo info = global.solve(space.identityMaps().maps, at, result);
+  EXPECT_LT(maxMapDifference(result.maps, space.identityMaps().maps), 1e-14);
+  EXPECT_EQ(info.initialViolation, 0.0);
+}
+
+TEST_F(GlobalStepTest, PolyhedralInputConvergesAtOnce) {
+  // §4.2: local and global steps between two polyhedral meshes reproduce the target, and
+  // a second iteration changes nothing.
+  const ShapeSpace space(generate::translationalSurface(8, 6));
+  const Positions target =
+      space.normalization().toWorld(test::applyProjectiveMap(space.basePositions(), test::samplePerspective()));
+  GlobalStep global(backend, space, {});
+  FaceMaps first;
+  global.solve(fitFaceMaps(backend, space, target).fits.maps, Positions(), first);
+  const Positions once = space.positions(first.maps);
+  EXPECT_LT(test::maxAbsDifference(once, target), 1e-10);
+  FaceMaps second;
+  const GlobalStepInfo info = global.solve(fitFaceMaps(backend, space, once).fits.maps, Positions(), second);
+  EXPECT_LE(info.admmIterations, 0);
+  EXPECT_LT(test::maxAbsDifference(space.positions(second.maps), once), 1e-10);
+}
+
+TEST_F(GlobalStepTest, PositionalConstraintsHoldAndTheScheduleIsRecorded) {
+  const PolygonMesh mesh = generate::translationalSurface(6, 6);
+  const ShapeSpace space(mesh);
+  const std::vector<Index> constrained = {0, 1, 2, 3, 4, 5, 6, 48};
+  Positions at(constrained.size(), 3);
+  for (std::size_t i = 0; i < constrained.size(); ++i) at.row(i) = mesh.vertices.row(constrained[i]);
+  at.row(7) += Eigen::RowVector3d(0.1, 0.05, 0.2);
+  GlobalStep global(backend, space, constrained);
+  FaceMaps result;
+  const GlobalStepInfo info = global.solve(conflictingTargets(space), at, result);
+  ASSERT_FALSE(info.attempts.empty());
+  EXPECT_GT(info.initialViolation, 0.0);
+  EXPECT_NEAR(info.attempts.front().epsilon, 1e-2 * info.initialViolation, 1e-15);
+  EXPECT_EQ(info.attempts.back().status, BoxQpStatus::Solved);
+  EXPECT_LE(info.constraintResidual, info.epsilon + 1e-9);
+  EXPECT_LT(info.positionalResidual, 1e-9);
+  const Positions p = space.positions(result.maps);
+  for (std::size_t i = 0; i < constrained.size(); ++i) {
+    EXPECT_LT((p.row(constrained[i]) - at.row(i)).norm(), 1e-9 * space.normalization().scale) << "vertex " << constrained[i];
+  }
+}
+
+TEST_F(GlobalStepTest, ExactFirstGivesExactlyPlanarFacesWhenFeasible) {
+  // Rigid targets of a polyhedral (parallelogram) grid with one row fixed: the affine
+  // shape space contains exact solutions, so eps = 0 is feasible.
+  const PolygonMesh mesh = generate::translationalSurface(6, 6);
+  const ShapeSpace space(mesh);
+  const std::vector<Index> fixed = {0, 1, 2, 3, 4, 5, 6};
+  Positions at(fixed.size(), 3);
+  for (std::size_t i = 0; i < fixed.size(); ++i) at.row(i) = mesh.vertices.row(fixed[i]);
+  GlobalStepSettings settings;
+  settings.epsilonStart = EpsilonStart::ExactFirst;
+  GlobalStep global(backend, space, fixed, settings);
+  FaceMaps result;
+  const GlobalStepInfo info = global.solve(conflictingTargets(space), at, result);
+  EXPECT_EQ(info.epsilon, 0.0);
+  EXPECT_LT(info.constraintResidual, 1e-10);
+  EXPECT_LT(maxPlanarity(space.positions(result.maps), mesh.faces), 1e-8);
+  EXPECT_GT(maxMapDifference(result.maps, space.identityMaps().maps), 1e-3);  // it did move
+}
+
+TEST_F(GlobalStepTest, CornerAtInfinityIsANumericalError) {
+  const ShapeSpace space(generate::cube());
+  std::vector<Eigen::Matrix4d> targets(space.faceCount(), Eigen::Matrix4d::Identity());
+  const Eigen::RowVector3d p = space.basePositions().row(0);
+  for (auto& T : targets) T.block<3, 1>(0, 3) = -p.transpose() / p.squaredNorm();
+  GlobalStep global(backend, space, {});
+  FaceMaps result;
+  try {
+    global.solve(targets, Positions(), result);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("vertex 0"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(GlobalStepTest, RejectsRepeatedConstrainedVertices) {
+  const ShapeSpace space(generate::cube());
+  EXPECT_THROW(GlobalStep(backend, space, {1, 1}), Error);
+  EXPECT_THROW(GlobalStep(backend, space, {8}), Error);
+}
+
+}  // namespace
+}  // namespace plano::projective
