@@ -38,6 +38,7 @@ Sequence::~Sequence() {
 
 void Sequence::begin() {
   Context::check(vkResetCommandBuffer(commands_, 0), "resetting a command buffer");
+  sets_.clear();
   auto info = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   Context::check(vkBeginCommandBuffer(commands_, &info), "beginning a command buffer");
   if (queries_) {
