@@ -244,9 +244,11 @@ void main() {
     const int k = offsets[f + 1] - begin;
     const int chunkCorner = begin - offsets[pc.firstFace];
 
-    dvec3 sourceCentroid, sourceNormal, targetCentroid, targetNormal;
-    bestFitPlane(false, begin, k, sourceCentroid, sourceNormal);
-    bestFitPlane(true, begin, k, targetCentroid, targetNormal);
+    // One call site for both planes keeps the inlined shader (and its JIT time) small.
+    dvec3 centers[2], normals[2];
+    for (int side = 0; side < 2; ++side) bestFitPlane(side == 1, begin, k, centers[side], normals[side]);
+    const dvec3 sourceCentroid = centers[0], sourceNormal = normals[0];
+    const dvec3 targetCentroid = centers[1], targetNormal = normals[1];
 
     for (int l = 0; l < N * N; ++l) A(l) = 0.0;
     for (int l = 0; l < N; ++l) c(l) = 0.0;
