@@ -61,6 +61,11 @@ DeviceCsrMatrix::DeviceCsrMatrix(Context& context, const compute::SparseMatrix& 
 
 DeviceVectors::DeviceVectors(Context& context, std::uint32_t n, std::uint32_t m, const char* what)
     : n_(n), m_(m), data_(context, static_cast<std::size_t>(n) * m, MemoryClass::Device, what) {
+  // Column c of a block is workgroup row c of the dispatches.
+  if (m > context.info().maxWorkGroupCount[1]) {
+    throwDevice(std::string("Vulkan: ") + what + " has " + std::to_string(m) + " columns, more than the device's " +
+                std::to_string(context.info().maxWorkGroupCount[1]) + " workgroups per dispatch row");
+  }
   if (static_cast<std::size_t>(n) * m * sizeof(double) > context.info().maxStorageBufferRange) {
     throwDevice(std::string("Vulkan: ") + what + " (" + std::to_string(n) + " x " + std::to_string(m) +
                 ") exceeds the device's storage-buffer range");
@@ -85,7 +90,7 @@ DeviceScalars::DeviceScalars(Context& context, std::uint32_t slots, std::uint32_
       groups_(std::clamp<std::uint32_t>((maxN + 4 * kWorkGroupSize - 1) / (4 * kWorkGroupSize), 1, 1024)),
       values_(context, static_cast<std::size_t>(slots) * m, MemoryClass::Device, "device scalars"),
       partial_(context, static_cast<std::size_t>(groups_) * m, MemoryClass::Device, "partial sums") {
-  groups_ = std::min(groups_, context.info().maxWorkGroupCount[0]);
+  groups_ = std::min(groups_, context.info().maxWorkGroupCount[0]);  // the kernels stride over the rest
 }
 
 std::vector<double> DeviceScalars::read() const {
