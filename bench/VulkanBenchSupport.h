@@ -16,7 +16,25 @@
 
 namespace plano::bench {
 
-/// The process-wide backend of a kind, or null with the reason in *error.
+/// Run every backend operation once on a tiny input, so that pipeline creation and the
+/// driver's JIT (~0.1-10 s per pipeline on lavapipe) stay out of the timed loops.
+inline void warmUp(compute::Backend& backend) {
+  const PolygonMesh cube = generate::cube();
+  std::vector<double> values(cube.faceCount());
+  backend.facePlanarity(cube, values);
+  compute::ProjectiveFits fits;
+  backend.fitProjectiveMaps(cube.faces, cube.vertices, cube.vertices, fits);
+  std::vector<Eigen::Matrix3d> matrices(1, Eigen::Matrix3d::Identity()), rotations(1);
+  std::vector<Eigen::Vector3d> singular(1);
+  backend.closestRotations(matrices, rotations, singular);
+  compute::SparseMatrix identity(8, 8);
+  identity.setIdentity();
+  identity.makeCompressed();
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(8, 3);
+  backend.createSpdSolver(identity, {})->solve(cube.vertices, X);
+}
+
+/// The process-wide backend of a kind (warmed up), or null with the reason in *error.
 inline compute::Backend* sharedBackend(compute::BackendChoice choice, std::string* error) {
   struct Slot {
     std::unique_ptr<compute::Backend> backend;
@@ -29,6 +47,7 @@ inline compute::Backend* sharedBackend(compute::BackendChoice choice, std::strin
     slot.tried = true;
     try {
       slot.backend = compute::createBackend(choice);
+      warmUp(*slot.backend);
     } catch (const std::exception& e) {
       slot.error = e.what();
     }

@@ -15,13 +15,13 @@
 // equations: planar faces give rank-deficient systems by design, and squaring their
 // condition number would blur the rank decision.
 //
-// The per-face work arrays live in shared memory, one slice per invocation, with
-// FIT_GROUP_SIZE invocations per workgroup. As private arrays they would be indexed
-// dynamically, which drivers lower to long select chains (slow to build and to run).
+// The per-face work arrays are private to the invocation. (Measured on lavapipe: slices
+// of shared memory instead, [element][lane], ran about 3x slower, and a one-sided Jacobi SVD
+// instead of the QR-based decomposition ~10x slower.)
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
-#define FIT_GROUP_SIZE 8
+#define FIT_GROUP_SIZE 64
 layout(local_size_x = FIT_GROUP_SIZE) in;
 
 layout(std430, binding = 0) readonly buffer Source { double source[]; };      // #V x 3
@@ -40,20 +40,18 @@ layout(push_constant) uniform Push {
 } pc;
 
 const int N = 15;
-// Element e of an invocation's array sits at [e][lane]: neighbouring invocations touch
-// neighbouring words (no bank conflicts on GPUs, contiguous vector accesses on lavapipe).
-shared double sharedA[N * N][FIT_GROUP_SIZE];  // row-major: R, then its decomposition
-shared double sharedC[N][FIT_GROUP_SIZE];      // Q^T r, then the solution
-shared double sharedRow[N][FIT_GROUP_SIZE];    // the equation being streamed in
-shared double sharedT[16][FIT_GROUP_SIZE];     // the map, column-major
-shared double sharedTau[N][FIT_GROUP_SIZE];    // Householder factors of the right reflections
-shared int sharedPerm[N][FIT_GROUP_SIZE];      // column permutation of the pivoted QR
-#define A(e) sharedA[e][gl_LocalInvocationID.x]
-#define tau(e) sharedTau[e][gl_LocalInvocationID.x]
-#define perm(e) sharedPerm[e][gl_LocalInvocationID.x]
-#define c(e) sharedC[e][gl_LocalInvocationID.x]
-#define row(e) sharedRow[e][gl_LocalInvocationID.x]
-#define t(e) sharedT[e][gl_LocalInvocationID.x]
+double privateA[N * N];  // row-major: R, then its decomposition
+double privateC[N];      // Q^T r, then the solution
+double privateRow[N];    // the equation being streamed in
+double privateT[16];     // the map, column-major
+double privateTau[N];    // Householder factors of the right reflections
+int privatePerm[N];      // column permutation of the pivoted QR
+#define A(e) privateA[e]
+#define tau(e) privateTau[e]
+#define perm(e) privatePerm[e]
+#define c(e) privateC[e]
+#define row(e) privateRow[e]
+#define t(e) privateT[e]
 
 dvec3 point(bool fromTarget, int v) {
   return fromTarget ? dvec3(target[3 * v], target[3 * v + 1], target[3 * v + 2])

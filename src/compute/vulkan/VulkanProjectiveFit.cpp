@@ -18,24 +18,14 @@ static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 
 static_assert(sizeof(int) == sizeof(std::int32_t), "ranks are 32-bit on the device");
 
 constexpr std::size_t kMapBytes = 16 * sizeof(double);
-// shaders/projective_fit.comp: FIT_GROUP_SIZE invocations, each with 225 + 3 * 15 + 16
-// doubles and 15 ints of shared memory.
-constexpr std::uint32_t kFitGroupSize = 8;
-constexpr std::size_t kSharedBytes = kFitGroupSize * ((225 + 3 * 15 + 16) * sizeof(double) + 15 * sizeof(int));
+// Workgroup size of shaders/projective_fit.comp (FIT_GROUP_SIZE).
+constexpr std::uint32_t kFitGroupSize = 64;
 
-void checkSharedMemory(const Context& context) {
-  if (context.info().maxSharedMemoryBytes < kSharedBytes) {
-    throwDevice("Vulkan: projective fits need " + std::to_string(kSharedBytes) + " bytes of shared memory per " +
-                "workgroup, device '" + context.info().name + "' offers " +
-                std::to_string(context.info().maxSharedMemoryBytes));
-  }
-}
 
 }  // namespace
 
 ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings settings)
-    : context_(context), settings_(settings), pipeline_((checkSharedMemory(context), context), "projective_fit", 8,
-                                                       sizeof(Push)) {}
+    : context_(context), settings_(settings), pipeline_(context, "projective_fit", 8, sizeof(Push)) {}
 
 void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
                               compute::ProjectiveFits& out) {
