@@ -96,3 +96,41 @@ TEST_F(VulkanFacePlanarity, StagingUploadPathGivesTheSameValues) {
 
 }  // namespace
 }  // namespace plano::test
+
+namespace plano::test {
+namespace {
+
+class VulkanFaceChecks : public VulkanTest {};
+
+TEST_F(VulkanFaceChecks, OutOfRangeCornerIsBadInputNamingTheFace) {
+  PolygonMesh mesh = generate::cube();
+  mesh.faces.addFace({0, 1, 8, 3});  // vertex 8 does not exist
+  std::vector<double> values(mesh.faceCount());
+  try {
+    backend().facePlanarity(mesh, values);
+    FAIL() << "expected Error(BadInput)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput);
+    EXPECT_NE(std::string(e.what()).find("face 6"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vertex 8"), std::string::npos) << e.what();
+  }
+  compute::ProjectiveFits fits;
+  EXPECT_THROW(backend().fitProjectiveMaps(mesh.faces, mesh.vertices, mesh.vertices, fits), Error);
+}
+
+TEST_F(VulkanFaceChecks, SequenceReportsDeviceTimeFromTimestamps) {
+  if (context().info().timestampPeriodNs <= 0.0) GTEST_SKIP() << "queue without timestamps";
+  vk::Sequence sequence(context());
+  EXPECT_LT(sequence.lastDeviceSeconds(), 0.0);  // nothing ran yet
+  vk::Array<double> a(context(), 1024, vk::MemoryClass::Device, "a"), b(context(), 1024, vk::MemoryClass::Device, "b");
+  sequence.begin();
+  sequence.copy(a, b, 1024 * sizeof(double));
+  sequence.end();
+  sequence.run();
+  sequence.run();  // a recorded sequence replays
+  EXPECT_GE(sequence.lastDeviceSeconds(), 0.0);
+  EXPECT_LT(sequence.lastDeviceSeconds(), 10.0);
+}
+
+}  // namespace
+}  // namespace plano::test

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -25,6 +26,7 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
                std::to_string(faceCount) + " faces");
   }
   if (faceCount == 0) return;
+  checkFaces(mesh.faces, mesh.vertexCount(), "facePlanarity");
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(mesh.vertices.size()) * sizeof(double);
   const std::size_t cornerBytes = mesh.faces.indices().size() * sizeof(Index);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -39,6 +40,7 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
   out.residuals.resize(faceCount);
   out.ranks.resize(faceCount);
   if (faceCount == 0) return;
+  checkFaces(faces, static_cast<Index>(source.rows()), "fitProjectiveMaps");
 
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
