@@ -126,7 +126,13 @@ void LinearAlgebra::dot(Sequence& sequence, const DeviceVectors& X, const Device
   // The same number of groups for every n keeps the partial buffer's layout fixed.
   sequence.dispatch(dot_, {X.data(), Y.data(), scalars.partial_}, DotPush{X.n()}, scalars.groups_, X.m());
   sequence.barrier();
-  sequence.dispatch(reduce_, {scalars.partial_, scalars.values_}, ReducePush{scalars.groups_, X.m(), slot}, X.m());
+  reduce(sequence, scalars, slot);
+}
+
+void LinearAlgebra::reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot) {
+  if (slot >= scalars.slots_) throwUsage("reduce: slot " + std::to_string(slot) + " out of range");
+  sequence.dispatch(reduce_, {scalars.partial_, scalars.values_}, ReducePush{scalars.groups_, scalars.m_, slot},
+                    scalars.m_);
   sequence.barrier();
 }
 

@@ -65,6 +65,10 @@ class DeviceScalars {
   }
   /// The device buffer, for kernels that read scalars (e.g. PCG step lengths).
   const Array<double>& values() const { return values_; }
+  /// First-pass scratch and its workgroup count, for fused kernels that produce partial
+  /// sums themselves (finished with LinearAlgebra::reduce).
+  const Array<double>& partial() const { return partial_; }
+  std::uint32_t groups() const { return groups_; }
 
  private:
   friend class LinearAlgebra;
@@ -85,6 +89,9 @@ class LinearAlgebra {
   /// scalars[slot][c] = X(:, c) . Y(:, c).
   void dot(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& Y, DeviceScalars& scalars,
            std::uint32_t slot);
+  /// Second pass of a dot product whose partial sums are already in scalars.partial():
+  /// scalars[slot][c] = sum of the column's partial sums.
+  void reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot);
   /// Y = a X + b Y.
   void axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y);
   /// Y = diag(d) X, d of n entries applied to every column.

@@ -11,6 +11,9 @@ namespace {
 struct StepPush {
   std::uint32_t n, m, slotRz, slotPq;
 };
+struct SpmvDotPush {
+  std::uint32_t n;
+};
 struct DirectionPush {
   std::uint32_t n, m, slotNew, slotOld;
 };
@@ -69,7 +72,8 @@ PcgSolver::PcgSolver(Context& context, const compute::SparseMatrix& A, const com
       algebra_(context),
       matrix_(context, A),
       inverseDiagonal_(context, n_, MemoryClass::Device, "inverse diagonal"),
-      step_(context, "pcg_step", 7, sizeof(StepPush)),
+      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(SpmvDotPush)),
+      step_(context, "pcg_step", 8, sizeof(StepPush)),
       direction_(context, "pcg_direction", 3, sizeof(DirectionPush)) {
   inverseDiagonal_.upload(inverseDiagonalOf(A));
 }
@@ -104,14 +108,20 @@ void PcgSolver::prepare(std::uint32_t m) {
     // update can read both the old and the new value without a copy.
     const std::uint32_t current = iteration % 2 == 0 ? kRzEven : kRzOdd;
     const std::uint32_t next = iteration % 2 == 0 ? kRzOdd : kRzEven;
-    la.spmv(w.block, matrix_, w.p, w.q);
-    la.dot(w.block, w.p, w.q, w.scalars, kPq);
+    // Five dispatches an iteration: q = A p with the partial sums of p.q, their reduction,
+    // the x/r/z update with the partial sums of the new r.z, their reduction, and p.
+    w.block.dispatch(spmvDot_,
+                     {matrix_.rowOffsets(), matrix_.columns(), matrix_.values(), w.p.data(), w.q.data(),
+                      w.scalars.partial()},
+                     SpmvDotPush{n_}, w.scalars.groups(), m);
+    w.block.barrier();
+    la.reduce(w.block, w.scalars, kPq);
     w.block.dispatch(step_,
                      {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseDiagonal_,
-                      w.scalars.values()},
-                     StepPush{n_, m, current, kPq}, groupsFor(context_, count));
+                      w.scalars.values(), w.scalars.partial()},
+                     StepPush{n_, m, current, kPq}, w.scalars.groups(), m);
     w.block.barrier();
-    la.dot(w.block, w.r, w.z, w.scalars, next);
+    la.reduce(w.block, w.scalars, next);
     w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},
                      DirectionPush{n_, m, next, current}, groupsFor(context_, count));
     w.block.barrier();

@@ -43,6 +43,7 @@ class PcgSolver final : public compute::SpdSolver {
   LinearAlgebra algebra_;
   DeviceCsrMatrix matrix_;
   Array<double> inverseDiagonal_;
+  Pipeline spmvDot_;
   Pipeline step_;
   Pipeline direction_;
   std::unique_ptr<Workspace> workspace_;

@@ -43,9 +43,10 @@ class Sequence {
   /// Finish recording (writes the end timestamp and a host-visibility barrier).
   void end();
 
-  /// Submit the recording and wait for it. Throws Error(Device) on device loss or when
-  /// the device does not finish within `timeoutSeconds`.
-  void run(double timeoutSeconds = 600.0);
+  /// Submit the recording and wait for it. Throws Error(Device) on device loss. There is
+  /// no host-side timeout: giving up on running work would leave its buffers in use, and
+  /// drivers report a hung device as lost.
+  void run();
 
   /// Device time of the last run() in seconds, from timestamp queries; a negative value
   /// when the queue has no timestamps.
