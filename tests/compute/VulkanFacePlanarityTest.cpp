@@ -118,6 +118,23 @@ TEST_F(VulkanFaceChecks, OutOfRangeCornerIsBadInputNamingTheFace) {
   EXPECT_THROW(backend().fitProjectiveMaps(mesh.faces, mesh.vertices, mesh.vertices, fits), Error);
 }
 
+TEST_F(VulkanFaceChecks, RepeatedCallsOnMeshesOfDifferentSizesReuseBuffersCorrectly) {
+  // Kernels keep their buffers between calls (grow-only): shrinking and growing again
+  // must neither read stale data nor overrun.
+  for (Index n : {30, 4, 17, 45}) {
+    PolygonMesh mesh = generate::hyparGrid(n, 0.3);
+    EXPECT_LT(worstRelativeDifference(backend(), mesh), 1e-12) << "n " << n;
+    compute::ProjectiveFits gpu, cpu;
+    const Positions target = perturbed(mesh.vertices, 0.01, static_cast<unsigned>(n));
+    backend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, gpu);
+    compute::CpuBackend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, cpu);
+    ASSERT_EQ(gpu.maps.size(), cpu.maps.size());
+    for (Index f = 0; f < mesh.faceCount(); ++f) {
+      ASSERT_LT((gpu.maps[f] - cpu.maps[f]).cwiseAbs().maxCoeff(), 1e-10) << "n " << n << " face " << f;
+    }
+  }
+}
+
 TEST_F(VulkanFaceChecks, SequenceReportsDeviceTimeFromTimestamps) {
   if (context().info().timestampPeriodNs <= 0.0) GTEST_SKIP() << "queue without timestamps";
   vk::Sequence sequence(context());

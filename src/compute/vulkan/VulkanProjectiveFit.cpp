@@ -49,14 +49,14 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                 std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
                 std::to_string(range) + " bytes; use the CPU backend");
   }
-  Array<double> sourceBuffer(context_, source.size(), MemoryClass::Device, "source positions");
-  sourceBuffer.upload({source.data(), static_cast<std::size_t>(source.size())});
-  Array<double> targetBuffer(context_, target.size(), MemoryClass::Device, "target positions");
-  targetBuffer.upload({target.data(), static_cast<std::size_t>(target.size())});
-  Array<Index> offsets(context_, faces.offsets().size(), MemoryClass::Device, "face offsets");
-  offsets.upload(faces.offsets());
-  Array<Index> indices(context_, faces.indices().size(), MemoryClass::Device, "face corners");
-  indices.upload(faces.indices());
+  ensureCapacity(source_, context_, source.size(), "source positions");
+  source_.upload({source.data(), static_cast<std::size_t>(source.size())});
+  ensureCapacity(target_, context_, target.size(), "target positions");
+  target_.upload({target.data(), static_cast<std::size_t>(target.size())});
+  ensureCapacity(offsets_, context_, faces.offsets().size(), "face offsets");
+  offsets_.upload(faces.offsets());
+  ensureCapacity(indices_, context_, faces.indices().size(), "face corners");
+  indices_.upload(faces.indices());
 
   // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
   // fit one storage binding.
@@ -69,12 +69,16 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
     maxCorners = std::max<std::size_t>(maxCorners, offset[last] - offset[first]);
     first = last;
   }
-  Buffer maps(context_, maxFaces * kMapBytes, MemoryClass::Device, "projective maps");
-  Array<double> scales(context_, maxCorners, MemoryClass::Device, "reciprocal scales");
-  Array<double> residuals(context_, maxFaces, MemoryClass::Device, "fit residuals");
-  Array<std::int32_t> ranks(context_, maxFaces, MemoryClass::Device, "fit ranks");
+  ensureCapacity(maps_, context_, maxFaces * 16, "projective maps");
+  ensureCapacity(scales_, context_, maxCorners, "reciprocal scales");
+  ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
+  ensureCapacity(ranks_, context_, maxFaces, "fit ranks");
   DescriptorSet set(context_, pipeline_,
-                    {sourceBuffer, targetBuffer, offsets, indices, maps, scales, residuals, ranks});
+                    {BufferRange(source_, 0, positionBytes), BufferRange(target_, 0, positionBytes),
+                     BufferRange(offsets_), BufferRange(indices_), BufferRange(maps_, 0, maxFaces * kMapBytes),
+                     BufferRange(scales_, 0, maxCorners * sizeof(double)),
+                     BufferRange(residuals_, 0, maxFaces * sizeof(double)),
+                     BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount;) {
     std::size_t last = std::min(faceCount, first + maxFaces);
@@ -86,10 +90,10 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                       groupsFor(context_, n, kFitGroupSize));
     sequence.end();
     sequence.run();
-    maps.download(out.maps.data() + first, n * kMapBytes);
-    scales.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
-    residuals.download(std::span<double>(out.residuals).subspan(first, n));
-    ranks.download(std::span<std::int32_t>(out.ranks.data() + first, n));
+    maps_.Buffer::download(out.maps.data() + first, n * kMapBytes);
+    scales_.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
+    residuals_.download(std::span<double>(out.residuals).subspan(first, n));
+    ranks_.download(std::span<std::int32_t>(out.ranks.data() + first, n));
     first = last;
   }
 }
