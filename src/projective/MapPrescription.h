@@ -7,6 +7,7 @@
 
 #include "compute/Backend.h"
 #include "mesh/Constraints.h"
+#include "projective/ConstrainedVertices.h"
 #include "projective/GlobalStep.h"
 #include "projective/ShapeSpace.h"
 
@@ -73,9 +74,5 @@ struct PrescriptionResult {
 PrescriptionResult prescribeMaps(compute::Backend& backend, const PolygonMesh& base,
                                  const MapPrescription& prescription, const std::vector<Index>& faces,
                                  const PositionalConstraints& constraints, const PrescriptionSettings& settings = {});
-
-/// Constrained vertices (fixed, then handles) and their world positions, in that order.
-std::vector<Index> constrainedVertices(const PositionalConstraints& constraints);
-Positions constrainedPositions(const PolygonMesh& base, const PositionalConstraints& constraints);
 
 }  // namespace plano::projective
