@@ -152,7 +152,6 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   qpSettings.rho = rho_;
   BoxQpSolver qp(backend_, P_, C, qpSettings);
   Eigen::MatrixXd x = T;
-  Eigen::MatrixXd y;
   bool solved = false;
   for (double eps : schedule) {
     Eigen::MatrixXd lower = d;
@@ -163,8 +162,10 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
         upper.row(r).array() += eps;
       }
     }
-    Eigen::MatrixXd xTry = x;
-    Eigen::MatrixXd yTry = y;
+    // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
+    // (its certificate), a poor warm start for the next eps.
+    Eigen::MatrixXd xTry = T;
+    Eigen::MatrixXd yTry;
     const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
     info.admmIterations += qpInfo.iterations;
@@ -181,9 +182,6 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
       solved = true;
       break;
     }
-    // Warm-start the next eps from this attempt: its iterate is close to the relaxed optimum.
-    x = xTry;
-    y = yTry;
   }
   if (!solved) {
     throwNumerical("global step: no feasible relaxation found; eps grew from " + formatDouble(schedule.front()) +

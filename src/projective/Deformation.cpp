@@ -1,0 +1,124 @@
+#include "projective/Deformation.h"
+
+#include <algorithm>
+
+#include "core/Error.h"
+#include "projective/LocalStep.h"
+
+namespace plano::projective {
+namespace {
+
+std::vector<Index> constrainedVertices(const PositionalConstraints& constraints) {
+  std::vector<Index> vertices = constraints.fixed;
+  for (const Handle& h : constraints.handles) vertices.push_back(h.vertex);
+  return vertices;
+}
+
+double maxRowDistance(const Positions& a, const Positions& b) {
+  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
+}
+
+}  // namespace
+
+const char* toString(DeformationStatus status) {
+  switch (status) {
+    case DeformationStatus::Converged: return "converged";
+    case DeformationStatus::MaxIterationsReached: return "max_iterations";
+    case DeformationStatus::NumericalFailure: return "numerical_failure";
+  }
+  return "unknown";
+}
+
+Deformation::Deformation(compute::Backend& backend, const PolygonMesh& base, const PositionalConstraints& constraints,
+                         const DeformationSettings& settings)
+    : backend_(backend),
+      settings_(settings),
+      space_(base),
+      constrained_(constrainedVertices(constraints)),
+      fixedCount_(static_cast<Index>(constraints.fixed.size())),
+      global_(backend, space_, constrained_, settings.global) {
+  if (settings_.maxIterations < 1) throwUsage("deformation: max iterations must be at least 1");
+  if (!(settings_.tolerance > 0.0)) throwUsage("deformation: tolerance must be positive");
+}
+
+DeformationInfo Deformation::solve(const Positions& handles, Positions& positions, const DeformationCallback& callback) {
+  const auto handleCount = static_cast<Eigen::Index>(constrained_.size()) - fixedCount_;
+  if (handles.rows() != handleCount) {
+    throwUsage("deformation: " + std::to_string(handles.rows()) + " handle positions for " +
+               std::to_string(handleCount) + " handles");
+  }
+  if (positions.rows() != space_.vertexCount()) positions = space_.baseMesh().vertices;
+  Positions targets(constrained_.size(), 3);
+  for (Index i = 0; i < fixedCount_; ++i) targets.row(i) = space_.baseMesh().vertices.row(constrained_[i]);
+  if (handleCount > 0) targets.bottomRows(handleCount) = handles;
+
+  const double diagonal = space_.normalization().scale;
+  const double planarityBound = std::max(settings_.planarityTolerance, planarityStats(space_.baseMesh()).max);
+  DeformationInfo info;
+  auto record = [&](DeformationPhase phase, const GlobalStepInfo& step, const Positions& next) {
+    DeformationIteration it;
+    it.iteration = ++info.iterations;
+    it.phase = phase;
+    it.epsilon = step.epsilon;
+    it.initialViolation = step.initialViolation;
+    it.constraintResidual = step.constraintResidual;
+    it.positionalResidual = step.positionalResidual;
+    it.admmIterations = step.admmIterations;
+    it.attempts = step.attempts;
+    it.displacement = maxRowDistance(next, positions) / diagonal;
+    it.maxPlanarity = planarityStats(PolygonMesh{next, space_.faces()}).max;
+    info.history.push_back(it);
+    if (callback) callback(it);
+    return it;
+  };
+
+  try {
+    bool converged = false;
+    FaceMaps maps;
+    // Phase 1 (§6.1): fit, closest rigid/similar map, global step.
+    for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
+      const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
+      const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy);
+      const GlobalStepInfo step = global_.solve(ideal, targets, maps);
+      const Positions next = space_.positions(maps.maps);
+      const DeformationIteration it = record(DeformationPhase::Ideal, step, next);
+      positions = next;
+      converged = it.displacement < settings_.tolerance;
+    }
+    // Phase 2 (§5 loop): projective fits of the current faces, projected with the same
+    // constraints, until the faces are planar again.
+    bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
+    for (int k = 0; k < settings_.maxProjectionIterations && !planar; ++k) {
+      const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
+      const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
+      const Positions next = space_.positions(maps.maps);
+      planar = record(DeformationPhase::Projection, step, next).maxPlanarity <= planarityBound;
+      positions = next;
+    }
+    info.status = converged && planar ? DeformationStatus::Converged : DeformationStatus::MaxIterationsReached;
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Numerical) throw;
+    info.status = DeformationStatus::NumericalFailure;
+    info.message = e.what();
+  }
+
+  info.planarity = planarityStats(PolygonMesh{positions, space_.faces()});
+  for (std::size_t i = 0; i < constrained_.size(); ++i) {
+    info.maxConstraintError = std::max(info.maxConstraintError, (positions.row(constrained_[i]) - targets.row(i)).norm());
+  }
+  return info;
+}
+
+DeformationResult deform(compute::Backend& backend, const PolygonMesh& base, const PositionalConstraints& constraints,
+                         const DeformationSettings& settings, const DeformationCallback& callback) {
+  Deformation deformation(backend, base, constraints, settings);
+  Positions handles(constraints.handles.size(), 3);
+  for (std::size_t i = 0; i < constraints.handles.size(); ++i) handles.row(i) = constraints.handles[i].position.transpose();
+  DeformationResult result;
+  result.mesh.faces = base.faces;
+  result.mesh.vertices = base.vertices;
+  result.info = deformation.solve(handles, result.mesh.vertices, callback);
+  return result;
+}
+
+}  // namespace plano::projective

@@ -1,0 +1,75 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "mesh/Generators.h"
+#include "mesh/MeshIO.h"
+#include "support/TestMeshes.h"
+
+namespace plano {
+namespace {
+
+class DeformCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    writeMesh(dir / "grid.obj", generate::translationalSurface(6, 6));
+    // Fixed row v = 0 (vertices 0, 7, ..., 42) and the opposite corner 48 lifted.
+    write("c.json", R"({"fixed": [0, 7, 14, 21, 28, 35, 42],
+                        "handles": [{"vertex": 48, "position": [1.1, 1.1, 0.4]}]})");
+  }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; }
+  std::string path(const std::string& name) const { return (dir / name).string(); }
+  test::TempDir dir;
+};
+
+TEST_F(DeformCommand, WritesTheMeshAndAReportWithTheSchedule) {
+  const auto r = test::runTool("deform " + path("grid.obj") + " --constraints " + path("c.json") + " -o " +
+                               path("out.obj") + " --report " + path("r.json"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("iteration 1"), std::string::npos) << r.err;
+  const PolygonMesh out = readMesh(dir / "out.obj");
+  EXPECT_NEAR(out.vertices(48, 2), 0.4, 1e-6);
+  std::ifstream in(dir / "r.json");
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["command"], "deform");
+  EXPECT_EQ(report["status"], "converged");
+  EXPECT_GT(report["iterations"].get<int>(), 1);
+  EXPECT_EQ(report["epsilon"].size(), report["iterations"].get<std::size_t>());
+  EXPECT_EQ(report["residuals"].size(), report["iterations"].get<std::size_t>());
+  EXPECT_LT(report["planarity"]["max"].get<double>(), 0.1);
+  for (const char* key : {"backend", "vertices", "faces", "seconds"}) EXPECT_TRUE(report.contains(key)) << key;
+}
+
+TEST_F(DeformCommand, BadConstraintFilesExitWithThree) {
+  write("twice.json", R"({"fixed": [3], "handles": [{"vertex": 3, "position": [0, 0, 1]}]})");
+  write("range.json", R"({"fixed": [49]})");
+  write("nan.json", R"({"handles": [{"vertex": 3, "position": [0, "x", 1]}]})");
+  write("broken.json", R"({"fixed": [1, )");
+  for (const char* name : {"twice.json", "range.json", "nan.json", "broken.json"}) {
+    const auto r = test::runTool("deform " + path("grid.obj") + " --constraints " + path(name) + " -o " + path("o.obj"));
+    EXPECT_EQ(r.exitCode, 3) << name << ": " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "o.obj")) << name;
+  }
+}
+
+TEST_F(DeformCommand, RefusesToOverwriteTheInputUnlessInPlace) {
+  const std::string args = "deform " + path("grid.obj") + " --constraints " + path("c.json") + " -o " + path("grid.obj");
+  EXPECT_EQ(test::runTool(args).exitCode, 2);
+  EXPECT_EQ(test::runTool(args + " --in-place").exitCode, 0);
+  EXPECT_NEAR(readMesh(dir / "grid.obj").vertices(48, 2), 0.4, 1e-6);
+}
+
+TEST_F(DeformCommand, IterationCapExitsWithFourAndWritesOnlyWithKeepPartial) {
+  const std::string args = "deform " + path("grid.obj") + " --constraints " + path("c.json") + " --max-iterations 1";
+  const auto failed = test::runTool(args + " -o " + path("a.obj") + " --report " + path("a.json"));
+  EXPECT_EQ(failed.exitCode, 4) << failed.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.obj"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "a.json"));
+  const auto kept = test::runTool(args + " -o " + path("b.obj") + " --keep-partial");
+  EXPECT_EQ(kept.exitCode, 4);
+  EXPECT_TRUE(std::filesystem::exists(dir / "b.obj"));
+}
+
+}  // namespace
+}  // namespace plano
