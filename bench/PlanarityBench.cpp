@@ -1,37 +1,28 @@
-// Per-face planarity of a whole mesh, per backend, on generated planar-quad meshes
-// from the Yas Island scale (~4k faces) to 1M faces.
-#include <benchmark/benchmark.h>
-
-#include <cmath>
-
-#include "compute/Backend.h"
-#include "mesh/Generators.h"
+// Per-face planarity of a whole mesh, per backend, on generated planar-quad meshes from
+// the Yas Island scale (~4k faces) to 1M faces. Vulkan times include the upload of the
+// mesh and the read-back of the values (what Backend::facePlanarity costs a caller).
+#include "VulkanBenchSupport.h"
 
 namespace {
 
-void BM_FacePlanarity(benchmark::State& state, plano::compute::BackendChoice choice) {
-  const auto side = static_cast<plano::Index>(std::lround(std::sqrt(static_cast<double>(state.range(0)))));
-  const plano::PolygonMesh mesh = plano::generate::translationalSurface(side, side);
-  std::unique_ptr<plano::compute::Backend> backend;
-  try {
-    backend = plano::compute::createBackend(choice);
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
+using plano::compute::BackendChoice;
+
+void BM_FacePlanarity(benchmark::State& state, BackendChoice choice) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   std::vector<double> values(mesh.faceCount());
   for (auto _ : state) {
     backend->facePlanarity(mesh, values);
     benchmark::DoNotOptimize(values.data());
   }
   state.counters["faces"] = mesh.faceCount();
-  state.counters["faces_per_s"] =
-      benchmark::Counter(static_cast<double>(mesh.faceCount()), benchmark::Counter::kIsIterationInvariantRate);
+  plano::bench::setThroughput(state, mesh.faceCount());
 }
 
-BENCHMARK_CAPTURE(BM_FacePlanarity, cpu, plano::compute::BackendChoice::Cpu)
-    ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_FacePlanarity, vulkan, plano::compute::BackendChoice::Vulkan)
-    ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FacePlanarity, cpu, BackendChoice::Cpu)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_FacePlanarity, cpu, BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_FacePlanarity, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_FacePlanarity, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
 
 }  // namespace

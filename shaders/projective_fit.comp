@@ -15,13 +15,13 @@
 // equations: planar faces give rank-deficient systems by design, and squaring their
 // condition number would blur the rank decision.
 //
-// The per-face work arrays live in shared memory, one slice per invocation, with
-// FIT_GROUP_SIZE invocations per workgroup. As private arrays they would be indexed
-// dynamically, which drivers lower to long select chains (slow to build and to run).
+// The per-face work arrays are private to the invocation. (Measured on lavapipe: slices
+// of shared memory instead, [element][lane], ran about 3x slower, and a one-sided Jacobi SVD
+// instead of the QR-based decomposition ~10x slower.)
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
-#define FIT_GROUP_SIZE 8
+#define FIT_GROUP_SIZE 64
 layout(local_size_x = FIT_GROUP_SIZE) in;
 
 layout(std430, binding = 0) readonly buffer Source { double source[]; };      // #V x 3
@@ -40,18 +40,18 @@ layout(push_constant) uniform Push {
 } pc;
 
 const int N = 15;
-shared double sharedA[FIT_GROUP_SIZE][N * N];  // row-major: R, then its decomposition
-shared double sharedC[FIT_GROUP_SIZE][N];      // Q^T r, then the solution
-shared double sharedRow[FIT_GROUP_SIZE][N];    // the equation being streamed in
-shared double sharedT[FIT_GROUP_SIZE][16];     // the map, column-major
-shared double sharedTau[FIT_GROUP_SIZE][N];    // Householder factors of the right reflections
-shared int sharedPerm[FIT_GROUP_SIZE][N];      // column permutation of the pivoted QR
-#define A sharedA[gl_LocalInvocationID.x]
-#define tau sharedTau[gl_LocalInvocationID.x]
-#define perm sharedPerm[gl_LocalInvocationID.x]
-#define c sharedC[gl_LocalInvocationID.x]
-#define row sharedRow[gl_LocalInvocationID.x]
-#define t sharedT[gl_LocalInvocationID.x]
+double privateA[N * N];  // row-major: R, then its decomposition
+double privateC[N];      // Q^T r, then the solution
+double privateRow[N];    // the equation being streamed in
+double privateT[16];     // the map, column-major
+double privateTau[N];    // Householder factors of the right reflections
+int privatePerm[N];      // column permutation of the pivoted QR
+#define A(e) privateA[e]
+#define tau(e) privateTau[e]
+#define perm(e) privatePerm[e]
+#define c(e) privateC[e]
+#define row(e) privateRow[e]
+#define t(e) privateT[e]
 
 dvec3 point(bool fromTarget, int v) {
   return fromTarget ? dvec3(target[3 * v], target[3 * v + 1], target[3 * v + 2])
@@ -110,19 +110,19 @@ dvec3 projected(dvec3 x, dvec3 center, dvec3 normal) { return x - normal * dot(x
 // Givens-rotate `row` (with right-hand side beta) into the triangular factor A, c.
 void streamRow(double beta) {
   for (int j = 0; j < N; ++j) {
-    if (row[j] == 0.0) continue;
-    const double rjj = A[j * N + j];
-    const double h = sqrt(rjj * rjj + row[j] * row[j]);
+    if (row(j) == 0.0) continue;
+    const double rjj = A(j * N + j);
+    const double h = sqrt(rjj * rjj + row(j) * row(j));
     const double cs = rjj / h;
-    const double sn = row[j] / h;
+    const double sn = row(j) / h;
     for (int l = j; l < N; ++l) {
-      const double x = A[j * N + l];
-      const double y = row[l];
-      A[j * N + l] = cs * x + sn * y;
-      row[l] = cs * y - sn * x;
+      const double x = A(j * N + l);
+      const double y = row(l);
+      A(j * N + l) = cs * x + sn * y;
+      row(l) = cs * y - sn * x;
     }
-    const double x = c[j];
-    c[j] = cs * x + sn * beta;
+    const double x = c(j);
+    c(j) = cs * x + sn * beta;
     beta = cs * beta - sn * x;
   }
 }
@@ -131,16 +131,16 @@ void streamRow(double beta) {
 // side for the correction from the identity: r = q_j - p_j.
 double equation(dvec3 p, dvec3 q, int j) {
   const dvec4 ph = dvec4(p, 1.0);
-  for (int l = 0; l < N; ++l) row[l] = 0.0;
-  for (int r = 0; r < 4; ++r) row[4 * j + r] = ph[r];
-  for (int r = 0; r < 3; ++r) row[12 + r] = -q[j] * ph[r];
+  for (int l = 0; l < N; ++l) row(l) = 0.0;
+  for (int r = 0; r < 4; ++r) row(4 * j + r) = ph[r];
+  for (int r = 0; r < 3; ++r) row(12 + r) = -q[j] * ph[r];
   return q[j] - p[j];
 }
 
 // Householder QR with column pivoting of A (in place, R in the upper triangle), applied
 // to c as well; returns the numerical rank.
 int pivotedQr(double threshold) {
-  for (int j = 0; j < N; ++j) perm[j] = j;
+  for (int j = 0; j < N; ++j) perm(j) = j;
   double maxPivot = 0.0;
   for (int k = 0; k < N; ++k) {
     // Pivot: the remaining column of largest norm (recomputed, not downdated: n is small).
@@ -148,7 +148,7 @@ int pivotedQr(double threshold) {
     double bestNorm2 = -1.0;
     for (int j = k; j < N; ++j) {
       double s = 0.0;
-      for (int i = k; i < N; ++i) s += A[i * N + j] * A[i * N + j];
+      for (int i = k; i < N; ++i) s += A(i * N + j) * A(i * N + j);
       if (s > bestNorm2) {
         bestNorm2 = s;
         best = j;
@@ -156,40 +156,40 @@ int pivotedQr(double threshold) {
     }
     if (best != k) {
       for (int i = 0; i < N; ++i) {
-        const double x = A[i * N + k];
-        A[i * N + k] = A[i * N + best];
-        A[i * N + best] = x;
+        const double x = A(i * N + k);
+        A(i * N + k) = A(i * N + best);
+        A(i * N + best) = x;
       }
-      const int p = perm[k];
-      perm[k] = perm[best];
-      perm[best] = p;
+      const int p = perm(k);
+      perm(k) = perm(best);
+      perm(best) = p;
     }
     const double norm = sqrt(bestNorm2);
     if (norm == 0.0) break;  // the remaining columns are exactly zero
-    const double x0 = A[k * N + k];
+    const double x0 = A(k * N + k);
     const double beta = x0 >= 0.0 ? -norm : norm;
     const double scale = 1.0 / (x0 - beta);
     const double h = (beta - x0) / beta;
-    // v = (1, A[k+1..][k] * scale); apply I - h v v^T to the columns right of k and to c.
+    // v = (1, A(k+1..)[k] * scale); apply I - h v v^T to the columns right of k and to c.
     for (int j = k + 1; j < N; ++j) {
-      double w = A[k * N + j];
-      for (int i = k + 1; i < N; ++i) w += A[i * N + k] * scale * A[i * N + j];
+      double w = A(k * N + j);
+      for (int i = k + 1; i < N; ++i) w += A(i * N + k) * scale * A(i * N + j);
       w *= h;
-      A[k * N + j] -= w;
-      for (int i = k + 1; i < N; ++i) A[i * N + j] -= w * A[i * N + k] * scale;
+      A(k * N + j) -= w;
+      for (int i = k + 1; i < N; ++i) A(i * N + j) -= w * A(i * N + k) * scale;
     }
-    double w = c[k];
-    for (int i = k + 1; i < N; ++i) w += A[i * N + k] * scale * c[i];
+    double w = c(k);
+    for (int i = k + 1; i < N; ++i) w += A(i * N + k) * scale * c(i);
     w *= h;
-    c[k] -= w;
-    for (int i = k + 1; i < N; ++i) c[i] -= w * A[i * N + k] * scale;
-    A[k * N + k] = beta;
-    for (int i = k + 1; i < N; ++i) A[i * N + k] = 0.0;
+    c(k) -= w;
+    for (int i = k + 1; i < N; ++i) c(i) -= w * A(i * N + k) * scale;
+    A(k * N + k) = beta;
+    for (int i = k + 1; i < N; ++i) A(i * N + k) = 0.0;
     maxPivot = max(maxPivot, abs(beta));
   }
   int rank = 0;
   for (int k = 0; k < N; ++k) {
-    if (abs(A[k * N + k]) > threshold * maxPivot) ++rank;
+    if (abs(A(k * N + k)) > threshold * maxPivot) ++rank;
   }
   return rank;
 }
@@ -199,39 +199,39 @@ int pivotedQr(double threshold) {
 // (T^{-1} c, 0). Leaves the solution, in pivoted order, in c.
 void minimumNormSolve(int rank) {
   for (int k = rank - 1; k >= 0; --k) {
-    // Reflection acting on columns {k, rank..N-1} that zeroes A[k][rank..N-1].
+    // Reflection acting on columns {k, rank..N-1} that zeroes A(k)[rank..N-1].
     double tail2 = 0.0;
-    for (int l = rank; l < N; ++l) tail2 += A[k * N + l] * A[k * N + l];
-    tau[k] = 0.0;
+    for (int l = rank; l < N; ++l) tail2 += A(k * N + l) * A(k * N + l);
+    tau(k) = 0.0;
     if (tail2 == 0.0) continue;
-    const double x0 = A[k * N + k];
+    const double x0 = A(k * N + k);
     const double beta = x0 >= 0.0 ? -sqrt(x0 * x0 + tail2) : sqrt(x0 * x0 + tail2);
     const double scale = 1.0 / (x0 - beta);
-    tau[k] = (beta - x0) / beta;
-    for (int l = rank; l < N; ++l) A[k * N + l] *= scale;  // v = (1, tail * scale), kept in place
+    tau(k) = (beta - x0) / beta;
+    for (int l = rank; l < N; ++l) A(k * N + l) *= scale;  // v = (1, tail * scale), kept in place
     for (int i = 0; i < k; ++i) {
-      double w = A[i * N + k];
-      for (int l = rank; l < N; ++l) w += A[k * N + l] * A[i * N + l];
-      w *= tau[k];
-      A[i * N + k] -= w;
-      for (int l = rank; l < N; ++l) A[i * N + l] -= w * A[k * N + l];
+      double w = A(i * N + k);
+      for (int l = rank; l < N; ++l) w += A(k * N + l) * A(i * N + l);
+      w *= tau(k);
+      A(i * N + k) -= w;
+      for (int l = rank; l < N; ++l) A(i * N + l) -= w * A(k * N + l);
     }
-    A[k * N + k] = beta;
+    A(k * N + k) = beta;
   }
   // Back substitution T y = c[0..r), then y is padded with zeros.
   for (int k = rank - 1; k >= 0; --k) {
-    double s = c[k];
-    for (int l = k + 1; l < rank; ++l) s -= A[k * N + l] * c[l];
-    c[k] = s / A[k * N + k];
+    double s = c(k);
+    for (int l = k + 1; l < rank; ++l) s -= A(k * N + l) * c(l);
+    c(k) = s / A(k * N + k);
   }
-  for (int l = rank; l < N; ++l) c[l] = 0.0;
+  for (int l = rank; l < N; ++l) c(l) = 0.0;
   for (int k = 0; k < rank; ++k) {
-    if (tau[k] == 0.0) continue;
-    double w = c[k];
-    for (int l = rank; l < N; ++l) w += A[k * N + l] * c[l];
-    w *= tau[k];
-    c[k] -= w;
-    for (int l = rank; l < N; ++l) c[l] -= w * A[k * N + l];
+    if (tau(k) == 0.0) continue;
+    double w = c(k);
+    for (int l = rank; l < N; ++l) w += A(k * N + l) * c(l);
+    w *= tau(k);
+    c(k) -= w;
+    for (int l = rank; l < N; ++l) c(l) -= w * A(k * N + l);
   }
 }
 
@@ -242,12 +242,14 @@ void main() {
     const int k = offsets[f + 1] - begin;
     const int chunkCorner = begin - offsets[pc.firstFace];
 
-    dvec3 sourceCentroid, sourceNormal, targetCentroid, targetNormal;
-    bestFitPlane(false, begin, k, sourceCentroid, sourceNormal);
-    bestFitPlane(true, begin, k, targetCentroid, targetNormal);
+    // One call site for both planes keeps the inlined shader (and its JIT time) small.
+    dvec3 centers[2], normals[2];
+    for (int side = 0; side < 2; ++side) bestFitPlane(side == 1, begin, k, centers[side], normals[side]);
+    const dvec3 sourceCentroid = centers[0], sourceNormal = normals[0];
+    const dvec3 targetCentroid = centers[1], targetNormal = normals[1];
 
-    for (int l = 0; l < N * N; ++l) A[l] = 0.0;
-    for (int l = 0; l < N; ++l) c[l] = 0.0;
+    for (int l = 0; l < N * N; ++l) A(l) = 0.0;
+    for (int l = 0; l < N; ++l) c(l) = 0.0;
     for (int corner = 0; corner < k; ++corner) {
       const int v = indices[begin + corner];
       const dvec3 p = projected(point(false, v), sourceCentroid, sourceNormal);
@@ -257,14 +259,14 @@ void main() {
 
     const int rank = pivotedQr(pc.rankThreshold);
     minimumNormSolve(rank);
-    for (int l = 0; l < 16; ++l) t[l] = 0.0;
-    for (int l = 0; l < N; ++l) t[perm[l]] = c[l];
-    t[0] += 1.0;
-    t[5] += 1.0;
-    t[10] += 1.0;
-    t[15] = 1.0;
+    for (int l = 0; l < 16; ++l) t(l) = 0.0;
+    for (int l = 0; l < N; ++l) t(perm(l)) = c(l);
+    t(0) += 1.0;
+    t(5) += 1.0;
+    t(10) += 1.0;
+    t(15) = 1.0;
 
-    const dvec4 column3 = dvec4(t[12], t[13], t[14], t[15]);
+    const dvec4 column3 = dvec4(t(12), t(13), t(14), t(15));
     double squaredResidual = 0.0;
     for (int corner = 0; corner < k; ++corner) {
       const int v = indices[begin + corner];
@@ -273,11 +275,11 @@ void main() {
       const double shat = dot(ph, column3);
       scales[chunkCorner + corner] = shat;
       for (int j = 0; j < 3; ++j) {
-        const double e = dot(ph, dvec4(t[4 * j], t[4 * j + 1], t[4 * j + 2], t[4 * j + 3])) - q[j] * shat;
+        const double e = dot(ph, dvec4(t(4 * j), t(4 * j + 1), t(4 * j + 2), t(4 * j + 3))) - q[j] * shat;
         squaredResidual += e * e;
       }
     }
-    for (int l = 0; l < 16; ++l) maps[16 * i + l] = t[l];
+    for (int l = 0; l < 16; ++l) maps[16 * i + l] = t(l);
     residuals[i] = k > 0 ? sqrt(squaredResidual / double(3 * k)) : 0.0;
     ranks[i] = rank;
   }

@@ -156,6 +156,17 @@ void checkFaceGeometry(Context& ctx) {
       continue;
     }
     const Severity severity = n <= 4 ? Severity::Error : Severity::Warning;
+    // Coincident consecutive corners first: they also make every angle at them look collinear.
+    bool coincident = false;
+    for (std::size_t k = 0; k < n && !coincident; ++k) {
+      if ((point(k + 1) - point(k)).squaredNorm() != 0.0) continue;
+      coincident = true;
+      ctx.issues.add(ValidationIssueKind::CollinearCorners, severity, f, face[(k + 1) % n], [&] {
+        return "face " + str(f) + ": corners " + std::to_string(k) + " and " + std::to_string((k + 1) % n) +
+               " (vertices " + str(face[k]) + ", " + str(face[(k + 1) % n]) + ") coincide";
+      });
+    }
+    if (coincident) continue;
     for (std::size_t k = 0; k < n; ++k) {
       const Eigen::Vector3d u = point(k) - point(k + 1);
       const Eigen::Vector3d w = point(k + 2) - point(k + 1);

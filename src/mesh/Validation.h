@@ -13,8 +13,9 @@
 //   non_manifold_vertex       separate fans of faces meeting at one vertex
 //   inconsistent_orientation  two faces traversing their shared edge in the same direction
 //   zero_area_face            a face whose vector area vanishes
-//   collinear_corners         three consecutive collinear corners in a quad (its diagonals
-//                             then meet at a corner and no projective map is defined)
+//   collinear_corners         three consecutive collinear corners, or two coincident ones,
+//                             in a triangle or quad (a quad's diagonals then meet at a
+//                             corner and no projective map is defined)
 //   duplicate_face            two faces with the same vertex set
 // Warnings (reported, the mesh is accepted):
 //   isolated_vertex           a vertex in no face

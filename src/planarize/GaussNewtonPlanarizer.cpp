@@ -1,29 +1,34 @@
 #include "planarize/GaussNewtonPlanarizer.h"
 
-#include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
 #include "core/Error.h"
+#include "mesh/Planarity.h"
 #include "planarize/Monitor.h"
 #include "planarize/Problem.h"
 
 namespace plano::planarize {
 namespace detail {
 
-/// Private caches of GaussNewtonPlanarizer: the reduced system's pattern, the slots every
-/// face writes into, and the per-face plane unknowns with what back-substitution needs.
+/// Private caches of GaussNewtonPlanarizer: constraint rows, the pattern of J J^T and the
+/// slots each vertex's incidences write into, and per-iteration Jacobian and residuals.
 struct GaussNewtonWorkspace {
-  compute::SparseMatrix system;     ///< 3 #free square, pattern fixed, values per iteration.
-  std::vector<int> faceSlotOffset;  ///< Per constrained face: start of its (3k)^2 slots.
-  std::vector<int> faceSlots;       ///< Value index of (corner a, corner b, row r, col c), -1 if fixed.
-  std::vector<int> diagonalSlots;   ///< 3 per free vertex.
-  Eigen::MatrixXd rhs;              ///< 3 #free x 1.
-  Eigen::MatrixXd solution;         ///< 3 #free x 1; warm start for iterative backends.
-  std::vector<Eigen::Vector4d> planes;  ///< (n, d) per constrained face.
-  std::vector<Eigen::Matrix4d> blockInverse;
-  std::vector<Eigen::Vector4d> blockRhs;
+  std::vector<std::array<Index, 4>> rows;  ///< Corners a, b, c, d of each run of four.
+  /// Per vertex (CSR): the (row, corner) pairs of the rows it takes part in; empty when fixed.
+  std::vector<int> incidenceOffset;
+  std::vector<std::pair<int, int>> incidences;
+  compute::SparseMatrix system;  ///< #rows square: J J^T + nu I.
+  std::vector<int> pairSlots;    ///< Per vertex, n_v^2 value indices (incidence p, incidence q).
+  std::vector<int> pairSlotOffset;
+  std::vector<int> diagonalSlots;
+  std::vector<Eigen::Matrix<double, 4, 3>> jacobian;  ///< Per row: gradient rows of its corners.
+  Eigen::VectorXd residual;                             ///< Per row: signed c_j.
+  Eigen::MatrixXd rhs, dual;                            ///< #rows x 1.
+  Positions step;                                       ///< #V x 3.
 };
 
 namespace {
@@ -34,171 +39,129 @@ int findSlot(const compute::SparseMatrix& m, int row, int col) {
   return static_cast<int>(std::lower_bound(begin, end, col) - m.innerIndexPtr());
 }
 
-void buildPattern(const Problem& problem, GaussNewtonWorkspace& ws) {
+void buildRows(const Problem& problem, GaussNewtonWorkspace& ws) {
   const FaceList& faces = *problem.faces;
-  const Index n = 3 * problem.freeCount;
-  std::vector<Eigen::Triplet<double>> triplets;
-  std::size_t total = 0;
-  for (Index f : problem.constrainedFaces) total += 9 * static_cast<std::size_t>(faces.degree(f) * faces.degree(f));
-  triplets.reserve(total + static_cast<std::size_t>(n));
-  for (Index row = 0; row < n; ++row) triplets.emplace_back(row, row, 0.0);
+  const Index vertexCount = static_cast<Index>(problem.freeIndex.size());
   for (Index f : problem.constrainedFaces) {
-    for (Index i : faces[f]) {
-      const Index fi = problem.freeIndex[i];
-      if (fi < 0) continue;
-      for (Index j : faces[f]) {
-        const Index fj = problem.freeIndex[j];
-        if (fj < 0) continue;
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * fi + r, 3 * fj + c, 0.0);
-      }
+    const auto face = faces[f];
+    const std::size_t k = face.size();
+    const std::size_t runs = (k == 4) ? 1 : k;
+    for (std::size_t i = 0; i < runs; ++i) {
+      ws.rows.push_back({face[i], face[(i + 1) % k], face[(i + 2) % k], face[(i + 3) % k]});
     }
   }
+  std::vector<int> count(static_cast<std::size_t>(vertexCount) + 1, 0);
+  for (const auto& row : ws.rows)
+    for (Index v : row)
+      if (problem.freeIndex[v] >= 0) ++count[v + 1];
+  for (Index v = 0; v < vertexCount; ++v) count[v + 1] += count[v];
+  ws.incidenceOffset = count;
+  ws.incidences.resize(static_cast<std::size_t>(count.back()));
+  std::vector<int> cursor(count.begin(), count.end() - 1);
+  for (std::size_t j = 0; j < ws.rows.size(); ++j)
+    for (int corner = 0; corner < 4; ++corner) {
+      const Index v = ws.rows[j][corner];
+      if (problem.freeIndex[v] >= 0) ws.incidences[cursor[v]++] = {static_cast<int>(j), corner};
+    }
+
+  const Index n = static_cast<Index>(ws.rows.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (Index j = 0; j < n; ++j) triplets.emplace_back(j, j, 0.0);
+  for (Index v = 0; v < vertexCount; ++v)
+    for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p)
+      for (int q = ws.incidenceOffset[v]; q < ws.incidenceOffset[v + 1]; ++q)
+        triplets.emplace_back(ws.incidences[p].first, ws.incidences[q].first, 0.0);
   ws.system.resize(n, n);
   ws.system.setFromTriplets(triplets.begin(), triplets.end());
   ws.system.makeCompressed();
   ws.diagonalSlots.resize(static_cast<std::size_t>(n));
-  for (Index row = 0; row < n; ++row) ws.diagonalSlots[row] = findSlot(ws.system, row, row);
-  ws.faceSlotOffset.resize(problem.constrainedFaces.size());
-  ws.faceSlots.clear();
-  ws.faceSlots.reserve(total);
-  for (std::size_t c = 0; c < problem.constrainedFaces.size(); ++c) {
-    const auto face = faces[problem.constrainedFaces[c]];
-    ws.faceSlotOffset[c] = static_cast<int>(ws.faceSlots.size());
-    for (Index i : face) {
-      for (Index j : face) {
-        const Index fi = problem.freeIndex[i];
-        const Index fj = problem.freeIndex[j];
-        for (int r = 0; r < 3; ++r)
-          for (int col = 0; col < 3; ++col)
-            ws.faceSlots.push_back(fi < 0 || fj < 0 ? -1 : findSlot(ws.system, 3 * fi + r, 3 * fj + col));
-      }
+  for (Index j = 0; j < n; ++j) ws.diagonalSlots[j] = findSlot(ws.system, j, j);
+  ws.pairSlotOffset.assign(static_cast<std::size_t>(vertexCount) + 1, 0);
+  for (Index v = 0; v < vertexCount; ++v) {
+    ws.pairSlotOffset[v] = static_cast<int>(ws.pairSlots.size());
+    for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p)
+      for (int q = ws.incidenceOffset[v]; q < ws.incidenceOffset[v + 1]; ++q)
+        ws.pairSlots.push_back(findSlot(ws.system, ws.incidences[p].first, ws.incidences[q].first));
+  }
+  ws.pairSlotOffset[vertexCount] = static_cast<int>(ws.pairSlots.size());
+  ws.jacobian.resize(ws.rows.size());
+  ws.residual.resize(n);
+}
+
+/// Residuals and Jacobian rows at Y; returns the merit sum c_j^2.
+/// A run with parallel diagonals has no usable gradient: its row is zero this iteration
+/// (its planarity still counts in the merit).
+double linearize(const Problem& problem, const Positions& Y, GaussNewtonWorkspace& ws) {
+  double merit = 0.0;
+  for (std::size_t j = 0; j < ws.rows.size(); ++j) {
+    const auto& r = ws.rows[j];
+    const Eigen::Vector3d a = Y.row(r[0]), b = Y.row(r[1]), c = Y.row(r[2]), d = Y.row(r[3]);
+    const Eigen::Vector3d d1 = c - a, d2 = d - b, e = b - a;
+    const Eigen::Vector3d m = d1.cross(d2);
+    const double mNorm = m.norm();
+    const double meanDiagonal = 0.5 * (d1.norm() + d2.norm());
+    Eigen::Matrix<double, 4, 3>& J = ws.jacobian[j];
+    if (!(mNorm > 1e-14 * d1.norm() * d2.norm()) || !(meanDiagonal > 0.0)) {
+      J.setZero();
+      ws.residual[static_cast<Index>(j)] = 0.0;
+      const double p = quadPlanarity(a, b, c, d) / 100.0;
+      merit += p * p;
+      continue;
     }
+    const double factor = 1.0 / (mNorm * meanDiagonal);
+    const double value = e.dot(m) * factor;
+    ws.residual[static_cast<Index>(j)] = value;
+    merit += value * value;
+    // Gradient of the triple product V = e.(d1 x d2); translations leave it unchanged.
+    J.row(0) = -(m + d2.cross(e)) * factor;
+    J.row(1) = (m - e.cross(d1)) * factor;
+    J.row(2) = d2.cross(e) * factor;
+    J.row(3) = e.cross(d1) * factor;
+    for (int corner = 0; corner < 4; ++corner)
+      if (problem.freeIndex[r[corner]] < 0) J.row(corner).setZero();
   }
+  return merit;
 }
 
-/// Penalty energy of Y: squared corner distances to each face's best-fit plane over h_f^2,
-/// plus closeness. The merit function of the step acceptance.
-double penaltyEnergy(const Problem& problem, const Positions& Y, double closeness) {
-  const FaceList& faces = *problem.faces;
-  double energy = 0.0;
-  for (std::size_t c = 0; c < problem.constrainedFaces.size(); ++c) {
-    const auto face = faces[problem.constrainedFaces[c]];
-    const FacePlane plane = bestFitPlane(Y, face);
-    double sum = 0.0;
-    for (Index i : face) {
-      const double distance = plane.normal.dot(Y.row(i).transpose() - plane.centroid);
-      sum += distance * distance;
-    }
-    energy += sum / (problem.faceSize[c] * problem.faceSize[c]);
+/// Assemble J J^T + softening I and c + J dx0; solve; write the step dx = dx0 - J^T y into ws.step.
+compute::LinearSolveInfo computeStep(const Problem& problem, const Positions& Y, double pullBack, double softening,
+                                     compute::Backend& backend, GaussNewtonWorkspace& ws) {
+  const double nu = softening;
+  const Index vertexCount = static_cast<Index>(problem.freeIndex.size());
+  ws.step.setZero(vertexCount, 3);
+  for (Index v = 0; v < vertexCount; ++v) {
+    if (problem.freeIndex[v] >= 0) ws.step.row(v) = pullBack * (problem.input.row(v) - Y.row(v));
   }
-  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-    if (problem.freeIndex[v] >= 0) energy += closeness * (Y.row(v) - problem.input.row(v)).squaredNorm();
-  }
-  return energy;
-}
-
-void fitPlanes(const Problem& problem, const Positions& Y, GaussNewtonWorkspace& ws) {
-  ws.planes.resize(problem.constrainedFaces.size());
-  for (std::size_t c = 0; c < problem.constrainedFaces.size(); ++c) {
-    const FacePlane plane = bestFitPlane(Y, (*problem.faces)[problem.constrainedFaces[c]]);
-    ws.planes[c] << plane.normal, plane.normal.dot(plane.centroid);
-  }
-}
-
-/// Fill the reduced system and right-hand side for the linearization at (Y, planes).
-/// Corner a of face f has the linearized residual n^k.x_a + (n_f, d_f).(x_a^k, -1) - n^k.x_a^k.
-void assemble(const Problem& problem, const Positions& Y, double closeness, double damping,
-              GaussNewtonWorkspace& ws) {
-  const FaceList& faces = *problem.faces;
-  constexpr double normalizationWeight = 1.0;
   double* values = ws.system.valuePtr();
   std::fill(values, values + ws.system.nonZeros(), 0.0);
-  ws.rhs.setZero(3 * problem.freeCount, 1);
-  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-    const Index fv = problem.freeIndex[v];
-    if (fv < 0) continue;
-    for (int r = 0; r < 3; ++r) {
-      values[ws.diagonalSlots[3 * fv + r]] += closeness + damping;
-      ws.rhs(3 * fv + r, 0) += closeness * problem.input(v, r) + damping * Y(v, r);
-    }
-  }
-  ws.blockInverse.resize(problem.constrainedFaces.size());
-  ws.blockRhs.resize(problem.constrainedFaces.size());
-  Eigen::Matrix<double, 4, Eigen::Dynamic> A;
-  Eigen::VectorXd b, q;
-  Eigen::MatrixXd K;
-  for (std::size_t c = 0; c < problem.constrainedFaces.size(); ++c) {
-    const auto face = faces[problem.constrainedFaces[c]];
-    const Index k = static_cast<Index>(face.size());
-    const double s = 1.0 / (problem.faceSize[c] * problem.faceSize[c]);
-    const Eigen::Vector4d& plane = ws.planes[c];
-    const Eigen::Vector3d normal = plane.head<3>();
-    A.resize(4, k);
-    b.resize(k);
-    for (Index a = 0; a < k; ++a) {
-      A.col(a) << Y.row(face[a]).transpose(), -1.0;
-      b[a] = normal.dot(Y.row(face[a]).transpose());
-    }
-    // Plane block B and its right-hand side: corner rows, linearized |n| = 1, damping.
-    const Eigen::Vector4d n0(normal.x(), normal.y(), normal.z(), 0.0);
-    Eigen::Matrix4d B = s * (A * A.transpose()) + normalizationWeight * (n0 * n0.transpose());
-    B.diagonal().array() += damping;
-    const Eigen::Vector4d g =
-        s * (A * b) + normalizationWeight * 0.5 * (normal.squaredNorm() + 1.0) * n0 + damping * plane;
-    const Eigen::Matrix4d Binv = B.inverse();
-    ws.blockInverse[c] = Binv;
-    ws.blockRhs[c] = g;
-    // Schur complement of the plane block: corner block (a, b) is K_ab n n^T with
-    // K = s I - s^2 A^T B^-1 A; the right-hand side of corner a is n (s b_a - s a_a^T B^-1 g).
-    K = -(s * s) * (A.transpose() * Binv * A);
-    K.diagonal().array() += s;
-    q = s * b - s * (A.transpose() * (Binv * g));
-    const Eigen::Matrix3d nnT = normal * normal.transpose();
-    const int* slots = ws.faceSlots.data() + ws.faceSlotOffset[c];
-    for (Index a = 0; a < k; ++a) {
-      const Index fa = problem.freeIndex[face[a]];
-      if (fa < 0) continue;
-      Eigen::Vector3d rhs = q[a] * normal;
-      for (Index bb = 0; bb < k; ++bb) {
-        if (problem.freeIndex[face[bb]] < 0) {
-          // A fixed corner's term moves to the right-hand side.
-          rhs -= K(a, bb) * normal.dot(Y.row(face[bb]).transpose()) * normal;
-          continue;
-        }
-        const int* block = slots + (a * k + bb) * 9;
-        for (int r = 0; r < 3; ++r)
-          for (int col = 0; col < 3; ++col) values[block[3 * r + col]] += K(a, bb) * nnT(r, col);
+  for (int slot : ws.diagonalSlots) values[slot] += nu;
+  ws.rhs = ws.residual;
+  for (Index v = 0; v < vertexCount; ++v) {
+    const int begin = ws.incidenceOffset[v], end = ws.incidenceOffset[v + 1];
+    const int* slots = ws.pairSlots.data() + ws.pairSlotOffset[v];
+    const int count = end - begin;
+    for (int p = 0; p < count; ++p) {
+      const auto [row, corner] = ws.incidences[begin + p];
+      const Eigen::RowVector3d gp = ws.jacobian[row].row(corner);
+      ws.rhs(row, 0) += gp.dot(ws.step.row(v));
+      for (int q = 0; q < count; ++q) {
+        const auto [otherRow, otherCorner] = ws.incidences[begin + q];
+        values[slots[p * count + q]] += gp.dot(ws.jacobian[otherRow].row(otherCorner));
       }
-      ws.rhs.block<3, 1>(3 * fa, 0) += rhs;
     }
   }
-}
-
-/// New planes from the solved positions (back-substitution of the eliminated block),
-/// rescaled to unit normals: the linearization point of the next iteration.
-void updatePlanes(const Problem& problem, const Positions& oldY, const Positions& newY, GaussNewtonWorkspace& ws) {
-  const FaceList& faces = *problem.faces;
-  for (std::size_t c = 0; c < problem.constrainedFaces.size(); ++c) {
-    const auto face = faces[problem.constrainedFaces[c]];
-    const double s = 1.0 / (problem.faceSize[c] * problem.faceSize[c]);
-    const Eigen::Vector3d normal = ws.planes[c].head<3>();
-    Eigen::Vector4d t = ws.blockRhs[c];
-    for (Index i : face) {
-      Eigen::Vector4d a;
-      a << oldY.row(i).transpose(), -1.0;
-      t -= s * normal.dot(newY.row(i).transpose()) * a;
+  // J J^T changes with every linearization: a fresh solver per step (a direct backend
+  // factors it; an iterative one starts from zero).
+  ws.dual.setZero(ws.system.rows(), 1);
+  const auto solver = backend.createSpdSolver(ws.system, compute::LinearSolverSettings{});
+  const compute::LinearSolveInfo info = solver->solve(ws.rhs, ws.dual);
+  for (Index v = 0; v < vertexCount; ++v) {
+    for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p) {
+      const auto [row, corner] = ws.incidences[p];
+      ws.step.row(v) -= ws.dual(row, 0) * ws.jacobian[row].row(corner);
     }
-    Eigen::Vector4d plane = ws.blockInverse[c] * t;
-    const double length = plane.head<3>().norm();
-    if (!(length > 1e-8) || !plane.allFinite()) {
-      const FacePlane fit = bestFitPlane(newY, face);
-      plane << fit.normal, fit.normal.dot(fit.centroid);
-    } else {
-      plane /= length;
-    }
-    ws.planes[c] = plane;
   }
+  return info;
 }
 
 }  // namespace
@@ -215,7 +178,7 @@ GaussNewtonPlanarizer::GaussNewtonPlanarizer(const FaceList& faces, const Positi
   const auto start = Clock::now();
   problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
   workspace_ = std::make_unique<detail::GaussNewtonWorkspace>();
-  detail::buildPattern(*problem_, *workspace_);
+  detail::buildRows(*problem_, *workspace_);
   precomputeSeconds_ = secondsSince(start);
 }
 
@@ -232,39 +195,42 @@ Info GaussNewtonPlanarizer::solve(Positions& vertices) {
   Info info;
   detail::Monitor monitor(problem, *backend_, settings_.tolerance);
   bool converged = monitor.record(Y, info);
-  detail::fitPlanes(problem, Y, ws);
-  double energy = detail::penaltyEnergy(problem, Y, settings_.closeness);
-  double damping = settings_.damping;
-  Positions candidate;
+  double merit = detail::linearize(problem, Y, ws);
+  // Fraction of the way back to the input each step aims for (the minimizer of
+  // mu |dx|^2 + w |x + dx - x_input|^2 before the constraints are imposed).
+  const double pullBack = settings_.closeness / (settings_.closeness + settings_.damping);
+  // Softening of the linearized constraints (Levenberg-Marquardt on the dual system):
+  // tiny, so that the step satisfies them; raised after a rejected step.
+  constexpr double minimumSoftening = 1e-9;
+  double softening = minimumSoftening;
+  bool pullBackActive = true;
   int rejectedInARow = 0;
+  Positions candidate;
   while (!converged && info.iterations < settings_.maxIterations) {
-    detail::assemble(problem, Y, settings_.closeness, damping, ws);
-    ws.solution.resize(3 * problem.freeCount, 1);
-    for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-      const Index fv = problem.freeIndex[v];
-      if (fv >= 0) ws.solution.block<3, 1>(3 * fv, 0) = Y.row(v).transpose();
-    }
-    // The matrix changes every iteration (it depends on the normals): a fresh solver per
-    // step; a direct backend factors it, an iterative one warm-starts from Y.
-    const auto solver = backend_->createSpdSolver(ws.system, compute::LinearSolverSettings{});
-    const compute::LinearSolveInfo solve = solver->solve(ws.rhs, ws.solution);
+    const compute::LinearSolveInfo solve =
+        detail::computeStep(problem, Y, pullBackActive ? pullBack : 0.0, softening, *backend_, ws);
     ++info.iterations;
     info.linearResidual = std::max(info.linearResidual, solve.relativeResidual);
-    if (!ws.solution.allFinite()) {
+    if (!ws.step.allFinite()) {
       throwNumerical("planarize: Gauss-Newton step became non-finite at iteration " + std::to_string(info.iterations));
     }
-    candidate = Y;
-    for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-      const Index fv = problem.freeIndex[v];
-      if (fv >= 0) candidate.row(v) = ws.solution.block<3, 1>(3 * fv, 0).transpose();
+    // Backtracking on the merit sum c_j^2 (a step that lands within the tolerance is
+    // always taken). The linearization at the accepted candidate is the next iteration's.
+    bool accepted = false;
+    double stepLength = 1.0;
+    for (int halving = 0; halving <= 5 && !accepted; ++halving, stepLength *= 0.5) {
+      candidate = Y + stepLength * ws.step;
+      const double candidateMerit = detail::linearize(problem, candidate, ws);
+      if (candidateMerit <= merit || monitor.wouldConverge(candidate)) {
+        accepted = true;
+        merit = candidateMerit;
+      }
     }
-    const double candidateEnergy = detail::penaltyEnergy(problem, candidate, settings_.closeness);
-    if (candidateEnergy <= energy * (1.0 + 1e-12)) {
-      detail::updatePlanes(problem, Y, candidate, ws);
-      const double change = (candidate - Y).cwiseAbs().maxCoeff();
+    if (accepted) {
+      const double change = stepLength * ws.step.cwiseAbs().maxCoeff();
       Y.swap(candidate);
-      energy = candidateEnergy;
-      damping = std::max(settings_.damping, damping * 0.1);
+      softening = std::max(minimumSoftening, softening * 0.1);
+      pullBackActive = true;
       rejectedInARow = 0;
       converged = monitor.record(Y, info);
       if (!converged && change < 1e-12) {
@@ -272,11 +238,14 @@ Info GaussNewtonPlanarizer::solve(Positions& vertices) {
         break;
       }
     } else {
-      // Levenberg-Marquardt: a step that raises the energy is retried, shorter.
-      damping *= 10.0;
+      // No decrease along the step: retry from Y with the pure Gauss-Newton projection
+      // (no pull towards the input, a descent direction for the merit) and more softening.
+      softening = std::min(1.0, softening * 10.0);
+      pullBackActive = false;
       ++info.rejectedSteps;
+      detail::linearize(problem, Y, ws);
       converged = monitor.record(Y, info);
-      if (++rejectedInARow > 12) {
+      if (++rejectedInARow > 8) {
         info.status = Status::Stalled;
         break;
       }

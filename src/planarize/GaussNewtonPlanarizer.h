@@ -1,26 +1,25 @@
 #pragma once
-// Planarization by Gauss-Newton steps on per-face plane constraints, in the manner of
-// guided projection (Tang, Sun, Gomes, Wallner, Pottmann, "Form-finding with polyhedral
-// meshes made simple", SIGGRAPH 2014), with the plane unknowns eliminated per face.
+// Planarization by Gauss-Newton steps on the planarity measure itself: one constraint per
+// run of four consecutive corners (one per quad, k per k-gon, none for triangles),
+//   c_j(x) = (b - a).((c - a) x (d - b)) / (|(c - a) x (d - b)| L_j),
+// the signed distance between the diagonals ac and bd over their mean length L_j: exactly
+// the papers' planarity (mesh/Planarity.h) with a sign. Each iteration linearizes c at x^k
+// (the normalizing factor |m| L frozen, so the row is grad V / (|m| L)) and takes the step
+//   min_dx |J dx + c|^2 + mu |dx|^2 + w |x^k + dx - x^input|^2
+// over the free vertices. With nu = mu + w and dx0 = (w / nu)(x^input - x^k), its solution is
+//   dx = dx0 - J^T y,   (J J^T + nu I) y = c + J dx0,
+// a scalar SPD system with one unknown per constraint row and the sparsity of "rows that
+// share a vertex": for quad meshes about #F unknowns and 9 entries per row, the size and
+// fill of ShapeUp's matrix, instead of the 3 #V unknowns with 3x3 blocks of the primal
+// normal equations (GuidedProjectionPlanarizer). Levenberg-Marquardt safeguard: a step
+// that raises the merit sum c_j^2 + w |x - x^input|^2 is retried with ten times mu.
 //
-// Unknowns: free vertex positions x_i and, per face f of degree >= 4, a plane (n_f, d_f).
-// Each iteration minimizes, around the current iterate (x^k, n^k, d^k),
-//   sum_f 1/h_f^2 sum_{i in f} (n^k.x_i + n_f.x_i^k - n^k.x_i^k - d_f)^2   (linearized n_f.x_i = d_f)
-//   + sum_f (n^k.n_f - (|n^k|^2 + 1)/2)^2                                 (linearized |n_f| = 1)
-//   + w sum_i |x_i - x_i^input|^2                                          (closeness)
-//   + eps (|x - x^k|^2 + |n - n^k|^2 + |d - d^k|^2)                        (Levenberg-Marquardt)
-// h_f is the face's mean diagonal, so the residual is the planarity measure's numerator
-// over its denominator. The 4x4 plane block of each face is eliminated (Schur complement),
-// leaving an SPD system in the 3 #free vertex coordinates whose face blocks are
-// K_ij n n^T: the sparsity of the mesh's face adjacency, fixed across iterations. A step
-// that raises the penalty energy (corner-to-best-plane distances + closeness) is
-// rejected and retried with ten times the damping.
-//
-// Why this method: measured on the issue's meshes, Gauss-Newton reaches 0.1 % in 4-30
-// iterations where ShapeUp needs hundreds and Anderson-accelerated ShapeUp tens to
-// hundreds (bench/PlanarizeBench.cpp), and each iteration costs one sparse factorization
-// of a 3 #V system, so it wins on wall time as well. The constraint is the point-to-plane
-// distance; the stopping criterion is the papers' diagonal-distance planarity.
+// Why this method (measured, bench/PlanarizeBench.cpp): Gauss-Newton needs a handful of
+// iterations where ShapeUp needs hundreds and Anderson-accelerated ShapeUp tens to hundreds,
+// and with the constraint-space ("dual") system each iteration costs one scalar sparse
+// factorization of the size of ShapeUp's prefactored matrix. The step is the smallest
+// displacement that makes the linearized faces planar, which keeps the mesh close to the
+// input. It is Goldenthal et al.'s fast projection (SCA 2007) applied to planarity.
 #include <memory>
 
 #include "compute/Backend.h"
@@ -34,9 +33,9 @@ struct GaussNewtonWorkspace;
 
 class GaussNewtonPlanarizer {
  public:
-  /// Precompute: check and normalize the input (#V x 3), build the sparsity pattern of the
-  /// reduced system and the per-face slots into it. `faces` and `backend` must outlive
-  /// this object.
+  /// Precompute: check and normalize the input (#V x 3), list the constraint rows, build the
+  /// sparsity pattern of J J^T and the slots each vertex writes into. `faces` and `backend`
+  /// must outlive this object.
   GaussNewtonPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
                         compute::Backend& backend);
   ~GaussNewtonPlanarizer();

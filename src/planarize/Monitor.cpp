@@ -30,4 +30,13 @@ bool Monitor::record(const Positions& normalized, Info& info) {
   return maxValue <= tolerance_;
 }
 
+bool Monitor::wouldConverge(const Positions& normalized) {
+  mesh_.vertices = normalized;
+  backend_->facePlanarity(mesh_, values_);
+  for (double v : values_) {
+    if (!(v <= tolerance_)) return false;
+  }
+  return true;
+}
+
 }  // namespace plano::planarize::detail

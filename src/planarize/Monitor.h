@@ -14,6 +14,8 @@ class Monitor {
   Monitor(const Problem& problem, compute::Backend& backend, double tolerance);
   /// Record the planarity of `normalized` positions in info; true when max <= tolerance.
   bool record(const Positions& normalized, Info& info);
+  /// Whether `normalized` positions meet the tolerance, without recording them.
+  bool wouldConverge(const Positions& normalized);
   double lastMax() const { return lastMax_; }
 
  private:

@@ -3,6 +3,7 @@
 #include "core/Error.h"
 #include "planarize/AndersonPlanarizer.h"
 #include "planarize/GaussNewtonPlanarizer.h"
+#include "planarize/GuidedProjectionPlanarizer.h"
 #include "planarize/ShapeUpPlanarizer.h"
 
 namespace plano::planarize {
@@ -11,7 +12,8 @@ Method parseMethod(const std::string& text) {
   if (text == "shapeup") return Method::ShapeUp;
   if (text == "anderson") return Method::Anderson;
   if (text == "gauss-newton") return Method::GaussNewton;
-  throwUsage("unknown planarization method '" + text + "' (use shapeup, anderson or gauss-newton)");
+  if (text == "guided") return Method::Guided;
+  throwUsage("unknown planarization method '" + text + "' (use gauss-newton, guided, anderson or shapeup)");
 }
 
 const char* toString(Method method) {
@@ -19,6 +21,7 @@ const char* toString(Method method) {
     case Method::ShapeUp: return "shapeup";
     case Method::Anderson: return "anderson";
     case Method::GaussNewton: return "gauss-newton";
+    case Method::Guided: return "guided";
   }
   return "unknown";
 }
@@ -38,6 +41,7 @@ Info planarize(const FaceList& faces, Positions& vertices, const Settings& setti
     case Method::ShapeUp: return ShapeUpPlanarizer(faces, input, settings, backend).solve(vertices);
     case Method::Anderson: return AndersonPlanarizer(faces, input, settings, backend).solve(vertices);
     case Method::GaussNewton: return GaussNewtonPlanarizer(faces, input, settings, backend).solve(vertices);
+    case Method::Guided: return GuidedProjectionPlanarizer(faces, input, settings, backend).solve(vertices);
   }
   throwUsage("planarize: unknown method");
 }

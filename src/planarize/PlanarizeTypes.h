@@ -20,10 +20,11 @@ namespace plano::planarize {
 enum class Method {
   ShapeUp,      ///< Plain local/global projection (Bouaziz et al. 2012), the field's reference.
   Anderson,     ///< ShapeUp's fixed point with safeguarded Anderson acceleration.
-  GaussNewton,  ///< Gauss-Newton on per-face plane constraints (guided projection).
+  GaussNewton,  ///< Gauss-Newton on the diagonal-distance constraints, constraint-space solve.
+  Guided,       ///< Gauss-Newton on per-face plane unknowns (guided projection), primal solve.
 };
 
-/// "shapeup", "anderson" or "gauss-newton"; throws Error(Usage) otherwise.
+/// "shapeup", "anderson", "gauss-newton" or "guided"; throws Error(Usage) otherwise.
 Method parseMethod(const std::string& text);
 const char* toString(Method method);
 
@@ -31,16 +32,20 @@ struct Settings {
   Method method = Method::GaussNewton;
   /// Stop once the largest face planarity (percent) is at most this.
   double tolerance = 0.1;
-  /// Weight of the closeness term |X - X_input|^2 (per vertex, in units of the mean face
-  /// size) against the planarity term (corner-to-plane distances over the face size).
-  /// Larger keeps the mesh closer to the input and leaves faces less planar.
+  /// Weight w of the closeness term |X - X_input|^2 (per vertex, in units of the mean face
+  /// size). ShapeUp, Anderson and guided: a penalty against the planarity term (corner
+  /// distances over the face size); larger keeps the mesh closer to the input and leaves
+  /// faces less planar at the fixed point. Gauss-Newton: planarity is a constraint, and
+  /// each step aims w / (w + damping) of the way back to the input before projecting
+  /// onto it; larger tends to the closest planar mesh, 0 to the smallest steps.
   double closeness = 1e-4;
   int maxIterations = 100;
   /// Vertices that keep their input position exactly (0-based).
   std::vector<Index> fixed;
   /// Anderson only: number of previous iterates the extrapolation combines.
   int andersonDepth = 6;
-  /// Gauss-Newton only: Levenberg-Marquardt damping towards the previous iterate.
+  /// Weight mu of |X - X_previous|^2. Guided: Levenberg-Marquardt damping (least value; it
+  /// grows after a rejected step). Gauss-Newton: sets the pull back to the input, above.
   double damping = 1e-4;
 };
 
@@ -63,7 +68,7 @@ struct Info {
   /// Largest relative residual of the global step's linear solves.
   double linearResidual = 0.0;
   /// Steps the safeguard rejected: Anderson extrapolations that raised the energy (the
-  /// plain step was taken instead), Gauss-Newton steps retried with more damping.
+  /// plain step was taken instead), Gauss-Newton and guided steps retried from the same iterate.
   int rejectedSteps = 0;
   double seconds = 0.0;  ///< Wall time of precompute + solve.
 };

@@ -60,8 +60,12 @@ Problem makeProblem(const FaceList& faces, const Positions& input, const Setting
   for (Index v = 0; v < vertexCount; ++v) {
     if (problem.freeIndex[v] >= 0) problem.freeIndex[v] = problem.freeCount++;
   }
-  if (settings.closeness == 0.0 && settings.fixed.empty()) {
-    throwUsage("planarize: with closeness 0 at least one vertex must be fixed (else the mesh may drift freely)");
+  // ShapeUp's global matrix is singular without an anchor (translations are free); the
+  // Gauss-Newton methods are damped and need none.
+  const bool needsAnchor = settings.method == Method::ShapeUp || settings.method == Method::Anderson;
+  if (needsAnchor && settings.closeness == 0.0 && settings.fixed.empty()) {
+    throwUsage(std::string("planarize: ") + toString(settings.method) +
+               " with closeness 0 needs at least one fixed vertex (else the mesh may drift freely)");
   }
 
   problem.boundingBoxDiagonal = boundingBoxDiagonal(input);

@@ -27,8 +27,8 @@ struct Problem {
 
 /// Validate and normalize. Throws Error(BadInput) for a non-finite coordinate, a face
 /// index out of range, a fixed vertex out of range or listed twice, and Error(Usage) for
-/// negative weights or tolerance, or a problem without any anchor (zero closeness and no
-/// fixed vertex leaves translations free).
+/// negative weights or tolerance, or a ShapeUp problem without any anchor (zero closeness
+/// and no fixed vertex leaves translations free).
 Problem makeProblem(const FaceList& faces, const Positions& input, const Settings& settings);
 
 /// Mean diagonal length of a face of degree >= 4 (mean over runs of four corners of the

@@ -180,6 +180,10 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
   Eigen::MatrixXd xPolished = x;
   Eigen::MatrixXd yPolished = Eigen::MatrixXd::Zero(m, q.cols());
   const double rhoP = settings_.polishRho;
+  // Columns with the same active set (always the case for all-equality problems) share
+  // one factorization.
+  std::vector<Eigen::Index> factoredRows;
+  std::unique_ptr<compute::SpdSolver> solver;
   for (Eigen::Index c = 0; c < q.cols(); ++c) {
     // Active set as in OSQP: equality rows, and rows whose dual pushes z onto a bound.
     std::vector<Eigen::Index> rows;
@@ -202,8 +206,11 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
     const compute::SparseMatrix CA = selector * C_;
     const compute::SparseMatrix CAt = CA.transpose();
     const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(targets.data(), active);
-    const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
-    auto solver = backend_.createSpdSolver(K, settings_.linearSolver);
+    if (!solver || rows != factoredRows) {
+      const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
+      solver = backend_.createSpdSolver(K, settings_.linearSolver);
+      factoredRows = rows;
+    }
     // Method of multipliers on the equality-constrained QP, warm-started from the ADMM duals.
     Eigen::VectorXd lambda = selector * y.col(c);
     Eigen::MatrixXd xc = x.col(c);

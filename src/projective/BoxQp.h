@@ -32,8 +32,8 @@ struct BoxQpSettings {
   bool adaptiveRho = true;
   double adaptiveRhoFactor = 5.0;    ///< Refactor only when rho moves by more than this factor.
   bool polish = true;
-  int polishIterations = 8;          ///< Method-of-multipliers refinements of the polish.
-  double polishRho = 1e6;            ///< Penalty of the polish's equality system.
+  int polishIterations = 30;         ///< Max method-of-multipliers refinements of the polish.
+  double polishRho = 1e9;            ///< Penalty of the polish's equality system.
   compute::LinearSolverSettings linearSolver;
 };
 

@@ -3,16 +3,11 @@
 #include <algorithm>
 
 #include "core/Error.h"
+#include "projective/ConstrainedVertices.h"
 #include "projective/LocalStep.h"
 
 namespace plano::projective {
 namespace {
-
-std::vector<Index> constrainedVertices(const PositionalConstraints& constraints) {
-  std::vector<Index> vertices = constraints.fixed;
-  for (const Handle& h : constraints.handles) vertices.push_back(h.vertex);
-  return vertices;
-}
 
 double maxRowDistance(const Positions& a, const Positions& b) {
   return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 
+#include "compute/vulkan/VulkanBuffer.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "core/Error.h"
 
@@ -39,7 +40,7 @@ TEST(VulkanContext, ValidationMessengerRecordsInvalidUsage) {
 
 TEST(VulkanContext, ForcedDeviceByIndexIsUsed) {
   vk::ContextSettings settings = validatedSettings();
-  settings.deviceOverride = "0";
+  settings.deviceOverride = std::to_string(0);  // (a literal trips a GCC 12 -Wrestrict false positive)
   vk::Context context(settings);
   EXPECT_EQ(context.info().index, 0u);
 }
@@ -53,6 +54,20 @@ TEST(VulkanContext, RealGpuOnlyRefusesCpuImplementationsWithReason) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Device);
     EXPECT_NE(std::string(e.what()).find("CPU implementation"), std::string::npos) << e.what();
+  }
+}
+
+TEST(VulkanContext, ImpossibleAllocationIsADeviceErrorNamingTheBuffer) {
+  // Validation off: the layer would (rightly) flag the oversized request itself.
+  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
+  settings.validation = false;
+  vk::Context context(settings);
+  try {
+    vk::Buffer huge(context, std::size_t(1) << 42, vk::MemoryClass::Device, "a 4 TiB test buffer");
+    FAIL() << "a 4 TiB allocation succeeded";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device);
+    EXPECT_NE(std::string(e.what()).find("a 4 TiB test buffer"), std::string::npos) << e.what();
   }
 }
 

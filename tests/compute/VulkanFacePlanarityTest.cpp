@@ -96,3 +96,58 @@ TEST_F(VulkanFacePlanarity, StagingUploadPathGivesTheSameValues) {
 
 }  // namespace
 }  // namespace plano::test
+
+namespace plano::test {
+namespace {
+
+class VulkanFaceChecks : public VulkanTest {};
+
+TEST_F(VulkanFaceChecks, OutOfRangeCornerIsBadInputNamingTheFace) {
+  PolygonMesh mesh = generate::cube();
+  mesh.faces.addFace({0, 1, 8, 3});  // vertex 8 does not exist
+  std::vector<double> values(mesh.faceCount());
+  try {
+    backend().facePlanarity(mesh, values);
+    FAIL() << "expected Error(BadInput)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput);
+    EXPECT_NE(std::string(e.what()).find("face 6"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vertex 8"), std::string::npos) << e.what();
+  }
+  compute::ProjectiveFits fits;
+  EXPECT_THROW(backend().fitProjectiveMaps(mesh.faces, mesh.vertices, mesh.vertices, fits), Error);
+}
+
+TEST_F(VulkanFaceChecks, RepeatedCallsOnMeshesOfDifferentSizesReuseBuffersCorrectly) {
+  // Kernels keep their buffers between calls (grow-only): shrinking and growing again
+  // must neither read stale data nor overrun.
+  for (Index n : {30, 4, 17, 45}) {
+    PolygonMesh mesh = generate::hyparGrid(n, 0.3);
+    EXPECT_LT(worstRelativeDifference(backend(), mesh), 1e-12) << "n " << n;
+    compute::ProjectiveFits gpu, cpu;
+    const Positions target = perturbed(mesh.vertices, 0.01, static_cast<unsigned>(n));
+    backend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, gpu);
+    compute::CpuBackend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, cpu);
+    ASSERT_EQ(gpu.maps.size(), cpu.maps.size());
+    for (Index f = 0; f < mesh.faceCount(); ++f) {
+      ASSERT_LT((gpu.maps[f] - cpu.maps[f]).cwiseAbs().maxCoeff(), 1e-10) << "n " << n << " face " << f;
+    }
+  }
+}
+
+TEST_F(VulkanFaceChecks, SequenceReportsDeviceTimeFromTimestamps) {
+  if (context().info().timestampPeriodNs <= 0.0) GTEST_SKIP() << "queue without timestamps";
+  vk::Sequence sequence(context());
+  EXPECT_LT(sequence.lastDeviceSeconds(), 0.0);  // nothing ran yet
+  vk::Array<double> a(context(), 1024, vk::MemoryClass::Device, "a"), b(context(), 1024, vk::MemoryClass::Device, "b");
+  sequence.begin();
+  sequence.copy(a, b, 1024 * sizeof(double));
+  sequence.end();
+  sequence.run();
+  sequence.run();  // a recorded sequence replays
+  EXPECT_GE(sequence.lastDeviceSeconds(), 0.0);
+  EXPECT_LT(sequence.lastDeviceSeconds(), 10.0);
+}
+
+}  // namespace
+}  // namespace plano::test

@@ -4,6 +4,7 @@
 
 #include <set>
 
+#include "core/Error.h"
 #include "mesh/MeshIO.h"
 #include "support/TestMeshes.h"
 
@@ -84,6 +85,23 @@ TEST(GoodInputCorpus, InfoCommandAcceptsEveryGoodFile) {
     EXPECT_EQ(result.exitCode, 0) << entry.path() << ": " << result.err;
     const bool expectWarning = warned.count(entry.path().filename()) > 0;
     EXPECT_EQ(result.err.find("warning") != std::string::npos, expectWarning) << entry.path() << ": " << result.err;
+  }
+}
+
+TEST(GoodInputCorpus, NonFiniteValueOfAnUnusedPlyPropertyIsAccepted) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float quality\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 nan\n1 0 0 inf\n0 1 0 1\n3 0 1 2\n";
+  EXPECT_EQ(parseMesh(ply, MeshFormat::Ply, "q.ply").vertexCount(), 3);
+  std::string bad = ply;
+  bad.replace(bad.find("1 0 0 inf"), 9, "1 nan 0 0");
+  try {
+    parseMesh(bad, MeshFormat::Ply, "q.ply");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("q.ply:12: vertex 1: coordinate y is not finite"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -184,6 +184,15 @@ TEST(Validation, ReportsCollinearCornersOfQuad) {
   EXPECT_NE(issue->message.find("are collinear"), std::string::npos);
 }
 
+TEST(Validation, ReportsCoincidentCornersOfQuad) {
+  PolygonMesh mesh = grid();
+  mesh.vertices.row(5) = mesh.vertices.row(1);  // face 0 = (0, 1, 5, 4): corners 1 and 2 coincide
+  const auto report = validate(mesh);
+  const auto* issue = findIssue(report, ValidationIssueKind::CollinearCorners);
+  ASSERT_NE(issue, nullptr);
+  EXPECT_EQ(issue->message, "face 0: corners 1 and 2 (vertices 1, 5) coincide");
+}
+
 TEST(Validation, CollinearCornersInLargerPolygonIsWarning) {
   // A hexagon whose corners 0, 1, 2 are on a line: a panel with a straight run.
   auto points = std::vector<Eigen::Vector3d>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 2, 0}, {0, 1, 0}};

@@ -83,23 +83,20 @@ TEST(GaussNewtonPlanarizer, FixedVerticesStayExactlyFixed) {
   EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
 }
 
-TEST(GaussNewtonPlanarizer, LargerClosenessMovesTheMeshLessAndLeavesItLessPlanar) {
+TEST(GaussNewtonPlanarizer, LargerClosenessMovesTheMeshLessAndStillReachesTheTolerance) {
   PolygonMesh mesh = generate::translationalSurface(8, 8);
   mesh.vertices = test::perturbed(mesh.vertices, 0.02);
   Settings settings;
-  settings.tolerance = 0.0;  // run to the fixed point of each weight
-  settings.maxIterations = 30;
+  settings.tolerance = 0.01;
   double previousDisplacement = std::numeric_limits<double>::infinity();
-  double previousPlanarity = -1.0;
-  for (const double closeness : {1e-5, 1e-3, 1e-1, 10.0}) {
+  for (const double closeness : {0.0, 1e-5, 1e-3}) {
     settings.closeness = closeness;
     Positions result;
     const Info info = run(mesh, result, settings);
-    const double planarity = maxPlanarity(mesh.faces, result);
+    EXPECT_EQ(info.status, Status::Converged) << "closeness " << closeness;
+    EXPECT_LE(maxPlanarity(mesh.faces, result), 0.01) << "closeness " << closeness;
     EXPECT_LT(info.meanDisplacement, previousDisplacement) << "closeness " << closeness;
-    EXPECT_GT(planarity, previousPlanarity) << "closeness " << closeness;
     previousDisplacement = info.meanDisplacement;
-    previousPlanarity = planarity;
   }
 }
 
@@ -143,19 +140,6 @@ TEST(GaussNewtonPlanarizer, RejectsBadInputNamingTheElement) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::BadInput);
     EXPECT_NE(std::string(e.what()).find("vertex 5"), std::string::npos) << e.what();
-  }
-}
-
-TEST(GaussNewtonPlanarizer, ZeroClosenessWithoutFixedVerticesIsAUsageError) {
-  const PolygonMesh mesh = generate::hyparGrid(3, 0.5);
-  compute::CpuBackend backend;
-  Settings settings;
-  settings.closeness = 0.0;
-  try {
-    GaussNewtonPlanarizer(mesh.faces, mesh.vertices, settings, backend);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Usage);
   }
 }
 

@@ -1,9 +1,9 @@
 #include "compute/vulkan/VulkanBackend.h"
 
-#include "compute/cpu/CpuBackend.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "compute/vulkan/VulkanClosestRotations.h"
 #include "compute/vulkan/VulkanFacePlanarity.h"
+#include "compute/vulkan/VulkanPcgSolver.h"
 #include "compute/vulkan/VulkanProjectiveFit.h"
 #include "core/Error.h"
 
@@ -35,10 +35,8 @@ void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, 
   rotations_->run(matrices, rotations, singularValues);
 }
 
-// Not yet ported to the device: the CPU reference solves.
-
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
-  return CpuBackend().createSpdSolver(A, settings);
+  return std::make_unique<vk::PcgSolver>(*context_, A, settings);
 }
 
 std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference preference) {

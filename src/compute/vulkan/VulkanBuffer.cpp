@@ -18,7 +18,13 @@ Buffer::Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, con
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  Context::check(vkCreateBuffer(device, &info, nullptr, &buffer_), "creating a buffer");
+  const VkResult created = vkCreateBuffer(device, &info, nullptr, &buffer_);
+  if (created != VK_SUCCESS) {
+    buffer_ = VK_NULL_HANDLE;
+    context_ = nullptr;
+    throwDevice(std::string("Vulkan: creating a ") + std::to_string(bytes_) + "-byte buffer for " + what_ +
+                " failed: " + resultName(created));
+  }
 
   VkMemoryRequirements requirements;
   vkGetBufferMemoryRequirements(device, buffer_, &requirements);

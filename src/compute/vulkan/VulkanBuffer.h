@@ -68,4 +68,14 @@ class Array : public Buffer {
   std::size_t count_ = 0;
 };
 
+/// Grow-only reuse: (re)allocate `array` as a Device buffer when it holds fewer than
+/// `count` elements, so that kernels called every iteration of a solver allocate once.
+template <class T>
+void ensureCapacity(Array<T>& array, Context& context, std::size_t count, const char* what) {
+  if (array.handle() == VK_NULL_HANDLE || array.count() < count) {
+    array = Array<T>();  // release first: old and new need not fit in memory together
+    array = Array<T>(context, count, MemoryClass::Device, what);
+  }
+}
+
 }  // namespace plano::vk

@@ -30,20 +30,22 @@ void ClosestRotationsKernel::run(std::span<const Eigen::Matrix3d> matrices, std:
   if (count == 0) return;
   constexpr std::size_t matrixBytes = sizeof(Eigen::Matrix3d);
   const std::size_t chunk = std::min(count, context_.info().maxStorageBufferRange / matrixBytes);
-  Buffer input(context_, chunk * matrixBytes, MemoryClass::Device, "3x3 matrices");
-  Buffer output(context_, chunk * matrixBytes, MemoryClass::Device, "closest rotations");
-  Buffer singular(context_, chunk * sizeof(Eigen::Vector3d), MemoryClass::Device, "singular values");
-  DescriptorSet set(context_, pipeline_, {input, output, singular});
+  ensureCapacity(input_, context_, chunk * 9, "3x3 matrices");
+  ensureCapacity(output_, context_, chunk * 9, "closest rotations");
+  ensureCapacity(singular_, context_, chunk * 3, "singular values");
+  DescriptorSet set(context_, pipeline_,
+                    {BufferRange(input_, 0, chunk * matrixBytes), BufferRange(output_, 0, chunk * matrixBytes),
+                     BufferRange(singular_, 0, chunk * sizeof(Eigen::Vector3d))});
   Sequence sequence(context_);
   for (std::size_t first = 0; first < count; first += chunk) {
     const std::size_t n = std::min(chunk, count - first);
-    input.upload(matrices.data() + first, n * matrixBytes);
+    input_.Buffer::upload(matrices.data() + first, n * matrixBytes);
     sequence.begin();
     sequence.dispatch(pipeline_, set, Push{static_cast<std::uint32_t>(n)}, groupsFor(context_, n));
     sequence.end();
     sequence.run();
-    output.download(rotations.data() + first, n * matrixBytes);
-    singular.download(singularValues.data() + first, n * sizeof(Eigen::Vector3d));
+    output_.Buffer::download(rotations.data() + first, n * matrixBytes);
+    singular_.Buffer::download(singularValues.data() + first, n * sizeof(Eigen::Vector3d));
   }
 }
 

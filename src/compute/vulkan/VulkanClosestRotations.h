@@ -21,6 +21,8 @@ class ClosestRotationsKernel {
  private:
   Context& context_;
   Pipeline pipeline_;
+  // Reused across calls (grow-only).
+  Array<double> input_, output_, singular_;
 };
 
 }  // namespace plano::vk

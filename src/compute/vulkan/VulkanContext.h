@@ -29,6 +29,9 @@ struct ContextSettings {
   /// Upload and download through staging buffers even when device memory is host
   /// visible (exercises the discrete-GPU path on lavapipe).
   bool forceStaging = false;
+  /// Cap on the workgroups of one dispatch dimension (0: the device's limit). Tests lower
+  /// it to exercise the kernels' grid-stride loops on small inputs.
+  std::uint32_t maxWorkGroups = 0;
 
   /// Settings with deviceOverride and validation read from the environment.
   static ContextSettings fromEnvironment(DeviceSelection selection);
@@ -42,7 +45,7 @@ struct DeviceInfo {
   bool shaderFloat64 = false;
   bool shaderInt64 = false;
   std::uint32_t maxStorageBufferRange = 0;
-  std::uint32_t maxWorkGroupCount[3] = {0, 0, 0};
+  std::uint32_t maxWorkGroupCount[3] = {0, 0, 0};  ///< Lowered by ContextSettings::maxWorkGroups.
   std::uint32_t maxWorkGroupInvocations = 0;
   std::uint32_t maxSharedMemoryBytes = 0;
   VkDeviceSize minStorageBufferOffsetAlignment = 1;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -25,6 +26,7 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
                std::to_string(faceCount) + " faces");
   }
   if (faceCount == 0) return;
+  checkFaces(mesh.faces, mesh.vertexCount(), "facePlanarity");
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(mesh.vertices.size()) * sizeof(double);
   const std::size_t cornerBytes = mesh.faces.indices().size() * sizeof(Index);
@@ -34,17 +36,19 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
                 std::to_string(range) + " bytes; use the CPU backend");
   }
 
-  Array<double> positions(context_, mesh.vertices.size(), MemoryClass::Device, "vertex positions");
-  positions.upload({mesh.vertices.data(), static_cast<std::size_t>(mesh.vertices.size())});
-  Array<Index> offsets(context_, mesh.faces.offsets().size(), MemoryClass::Device, "face offsets");
-  offsets.upload(mesh.faces.offsets());
-  Array<Index> indices(context_, mesh.faces.indices().size(), MemoryClass::Device, "face corners");
-  indices.upload(mesh.faces.indices());
+  ensureCapacity(positions_, context_, mesh.vertices.size(), "vertex positions");
+  positions_.upload({mesh.vertices.data(), static_cast<std::size_t>(mesh.vertices.size())});
+  ensureCapacity(offsets_, context_, mesh.faces.offsets().size(), "face offsets");
+  offsets_.upload(mesh.faces.offsets());
+  ensureCapacity(indices_, context_, mesh.faces.indices().size(), "face corners");
+  indices_.upload(mesh.faces.indices());
 
   // The output is the one per-face array; split the faces so each chunk's fits one binding.
   const std::size_t chunk = std::min(faceCount, range / sizeof(double));
-  Array<double> values(context_, chunk, MemoryClass::Device, "face planarity");
-  DescriptorSet set(context_, pipeline_, {positions, offsets, indices, values});
+  ensureCapacity(values_, context_, chunk, "face planarity");
+  DescriptorSet set(context_, pipeline_,
+                    {BufferRange(positions_, 0, positionBytes), BufferRange(offsets_), BufferRange(indices_),
+                     BufferRange(values_, 0, chunk * sizeof(double))});
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount; first += chunk) {
     const std::size_t count = std::min(chunk, faceCount - first);
@@ -53,7 +57,7 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
                       groupsFor(context_, count));
     sequence.end();
     sequence.run();
-    values.download(out.subspan(first, count));
+    values_.download(out.subspan(first, count));
   }
 }
 

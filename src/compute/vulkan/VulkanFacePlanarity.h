@@ -21,6 +21,11 @@ class FacePlanarityKernel {
  private:
   Context& context_;
   Pipeline pipeline_;
+  // Reused across calls (grow-only).
+  Array<double> positions_;
+  Array<Index> offsets_;
+  Array<Index> indices_;
+  Array<double> values_;
 };
 
 }  // namespace plano::vk

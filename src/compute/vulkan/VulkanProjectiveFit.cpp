@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -18,24 +19,14 @@ static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 
 static_assert(sizeof(int) == sizeof(std::int32_t), "ranks are 32-bit on the device");
 
 constexpr std::size_t kMapBytes = 16 * sizeof(double);
-// shaders/projective_fit.comp: FIT_GROUP_SIZE invocations, each with 225 + 3 * 15 + 16
-// doubles and 15 ints of shared memory.
-constexpr std::uint32_t kFitGroupSize = 8;
-constexpr std::size_t kSharedBytes = kFitGroupSize * ((225 + 3 * 15 + 16) * sizeof(double) + 15 * sizeof(int));
+// Workgroup size of shaders/projective_fit.comp (FIT_GROUP_SIZE).
+constexpr std::uint32_t kFitGroupSize = 64;
 
-void checkSharedMemory(const Context& context) {
-  if (context.info().maxSharedMemoryBytes < kSharedBytes) {
-    throwDevice("Vulkan: projective fits need " + std::to_string(kSharedBytes) + " bytes of shared memory per " +
-                "workgroup, device '" + context.info().name + "' offers " +
-                std::to_string(context.info().maxSharedMemoryBytes));
-  }
-}
 
 }  // namespace
 
 ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings settings)
-    : context_(context), settings_(settings), pipeline_((checkSharedMemory(context), context), "projective_fit", 8,
-                                                       sizeof(Push)) {}
+    : context_(context), settings_(settings), pipeline_(context, "projective_fit", 8, sizeof(Push)) {}
 
 void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
                               compute::ProjectiveFits& out) {
@@ -49,6 +40,7 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
   out.residuals.resize(faceCount);
   out.ranks.resize(faceCount);
   if (faceCount == 0) return;
+  checkFaces(faces, static_cast<Index>(source.rows()), "fitProjectiveMaps");
 
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
@@ -57,14 +49,14 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                 std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
                 std::to_string(range) + " bytes; use the CPU backend");
   }
-  Array<double> sourceBuffer(context_, source.size(), MemoryClass::Device, "source positions");
-  sourceBuffer.upload({source.data(), static_cast<std::size_t>(source.size())});
-  Array<double> targetBuffer(context_, target.size(), MemoryClass::Device, "target positions");
-  targetBuffer.upload({target.data(), static_cast<std::size_t>(target.size())});
-  Array<Index> offsets(context_, faces.offsets().size(), MemoryClass::Device, "face offsets");
-  offsets.upload(faces.offsets());
-  Array<Index> indices(context_, faces.indices().size(), MemoryClass::Device, "face corners");
-  indices.upload(faces.indices());
+  ensureCapacity(source_, context_, source.size(), "source positions");
+  source_.upload({source.data(), static_cast<std::size_t>(source.size())});
+  ensureCapacity(target_, context_, target.size(), "target positions");
+  target_.upload({target.data(), static_cast<std::size_t>(target.size())});
+  ensureCapacity(offsets_, context_, faces.offsets().size(), "face offsets");
+  offsets_.upload(faces.offsets());
+  ensureCapacity(indices_, context_, faces.indices().size(), "face corners");
+  indices_.upload(faces.indices());
 
   // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
   // fit one storage binding.
@@ -77,12 +69,16 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
     maxCorners = std::max<std::size_t>(maxCorners, offset[last] - offset[first]);
     first = last;
   }
-  Buffer maps(context_, maxFaces * kMapBytes, MemoryClass::Device, "projective maps");
-  Array<double> scales(context_, maxCorners, MemoryClass::Device, "reciprocal scales");
-  Array<double> residuals(context_, maxFaces, MemoryClass::Device, "fit residuals");
-  Array<std::int32_t> ranks(context_, maxFaces, MemoryClass::Device, "fit ranks");
+  ensureCapacity(maps_, context_, maxFaces * 16, "projective maps");
+  ensureCapacity(scales_, context_, maxCorners, "reciprocal scales");
+  ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
+  ensureCapacity(ranks_, context_, maxFaces, "fit ranks");
   DescriptorSet set(context_, pipeline_,
-                    {sourceBuffer, targetBuffer, offsets, indices, maps, scales, residuals, ranks});
+                    {BufferRange(source_, 0, positionBytes), BufferRange(target_, 0, positionBytes),
+                     BufferRange(offsets_), BufferRange(indices_), BufferRange(maps_, 0, maxFaces * kMapBytes),
+                     BufferRange(scales_, 0, maxCorners * sizeof(double)),
+                     BufferRange(residuals_, 0, maxFaces * sizeof(double)),
+                     BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount;) {
     std::size_t last = std::min(faceCount, first + maxFaces);
@@ -94,10 +90,10 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                       groupsFor(context_, n, kFitGroupSize));
     sequence.end();
     sequence.run();
-    maps.download(out.maps.data() + first, n * kMapBytes);
-    scales.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
-    residuals.download(std::span<double>(out.residuals).subspan(first, n));
-    ranks.download(std::span<std::int32_t>(out.ranks.data() + first, n));
+    maps_.Buffer::download(out.maps.data() + first, n * kMapBytes);
+    scales_.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
+    residuals_.download(std::span<double>(out.residuals).subspan(first, n));
+    ranks_.download(std::span<std::int32_t>(out.ranks.data() + first, n));
     first = last;
   }
 }

@@ -27,6 +27,11 @@ class ProjectiveFitKernel {
   Context& context_;
   ProjectiveFitSettings settings_;
   Pipeline pipeline_;
+  // Reused across calls (grow-only): a local/global loop allocates once.
+  Array<double> source_, target_;
+  Array<Index> offsets_, indices_;
+  Array<double> maps_, scales_, residuals_;
+  Array<std::int32_t> ranks_;
 };
 
 }  // namespace plano::vk

@@ -38,6 +38,7 @@ Sequence::~Sequence() {
 
 void Sequence::begin() {
   Context::check(vkResetCommandBuffer(commands_, 0), "resetting a command buffer");
+  sets_.clear();
   auto info = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   Context::check(vkBeginCommandBuffer(commands_, &info), "beginning a command buffer");
   if (queries_) {
@@ -95,7 +96,7 @@ void Sequence::end() {
   recorded_ = true;
 }
 
-void Sequence::run(double timeoutSeconds) {
+void Sequence::run() {
   if (!recorded_) throwDevice("Vulkan: run() of a sequence that was not recorded (begin()/end())");
   VkDevice device = context_.device();
   Context::check(vkResetFences(device, 1, &fence_), "resetting a fence");
@@ -103,13 +104,7 @@ void Sequence::run(double timeoutSeconds) {
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &commands_;
   Context::check(vkQueueSubmit(context_.queue(), 1, &submit, fence_), "submitting work to the compute queue");
-  const auto timeout = static_cast<std::uint64_t>(timeoutSeconds * 1e9);
-  const VkResult result = vkWaitForFences(device, 1, &fence_, VK_TRUE, timeout);
-  if (result == VK_TIMEOUT) {
-    throwDevice("Vulkan: the device did not finish a submitted batch within " +
-                std::to_string(static_cast<int>(timeoutSeconds)) + " s");
-  }
-  Context::check(result, "waiting for the compute queue");
+  Context::check(vkWaitForFences(device, 1, &fence_, VK_TRUE, UINT64_MAX), "waiting for the compute queue");
   ran_ = true;
 }
 

@@ -3,7 +3,9 @@
 // barriers recorded once into a command buffer and submitted as one batch, as often as
 // needed. Timestamps at the start and end of each recording give the device time.
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <vector>
 
 #include "compute/vulkan/VulkanPipeline.h"
 
@@ -26,6 +28,14 @@ class Sequence {
                 std::uint32_t groupsY = 1) {
     dispatch(pipeline, set, std::as_bytes(std::span<const Push>(&push, 1)), groupsX, groupsY);
   }
+  /// Record a dispatch with the given buffers bound; the sequence keeps their descriptor
+  /// set alive until the next begin().
+  template <class Push>
+  void dispatch(const Pipeline& pipeline, std::initializer_list<BufferRange> buffers, const Push& push,
+                std::uint32_t groupsX, std::uint32_t groupsY = 1) {
+    sets_.push_back(std::make_unique<DescriptorSet>(context_, pipeline, buffers));
+    dispatch(pipeline, *sets_.back(), push, groupsX, groupsY);
+  }
   /// Make every earlier shader or transfer write visible to every later shader or transfer.
   void barrier();
   void copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset = 0,
@@ -33,9 +43,10 @@ class Sequence {
   /// Finish recording (writes the end timestamp and a host-visibility barrier).
   void end();
 
-  /// Submit the recording and wait for it. Throws Error(Device) on device loss or when
-  /// the device does not finish within `timeoutSeconds`.
-  void run(double timeoutSeconds = 600.0);
+  /// Submit the recording and wait for it. Throws Error(Device) on device loss. There is
+  /// no host-side timeout: giving up on running work would leave its buffers in use, and
+  /// drivers report a hung device as lost.
+  void run();
 
   /// Device time of the last run() in seconds, from timestamp queries; a negative value
   /// when the queue has no timestamps.
@@ -46,6 +57,7 @@ class Sequence {
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
+  std::vector<std::unique_ptr<DescriptorSet>> sets_;
   bool recording_ = false;
   bool recorded_ = false;
   bool ran_ = false;

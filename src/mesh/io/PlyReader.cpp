@@ -22,7 +22,7 @@ class AsciiBody {
   double value(PlyType type, const char* what) {
     const std::string_view token = next(what);
     if (plyIsInteger(type)) return static_cast<double>(cursor_.toInteger(token, what));
-    return cursor_.toDouble(token, what);
+    return cursor_.toDouble(token, what, /*allowNonFinite=*/true);  // checked where it matters
   }
   std::int64_t integer(PlyType type, const char* what) {
     const std::string_view token = next(what);
@@ -62,8 +62,8 @@ class BinaryBody {
       case PlyType::UInt16: return read<std::uint16_t>(what);
       case PlyType::Int32: return read<std::int32_t>(what);
       case PlyType::UInt32: return read<std::uint32_t>(what);
-      case PlyType::Float32: return finite(read<float>(what), what);
-      case PlyType::Float64: return finite(read<double>(what), what);
+      case PlyType::Float32: return read<float>(what);
+      case PlyType::Float64: return read<double>(what);
     }
     return 0.0;
   }
@@ -91,10 +91,6 @@ class BinaryBody {
     T value;
     std::memcpy(&value, bytes, sizeof(T));
     return value;
-  }
-  double finite(double x, const char* what) const {
-    if (!std::isfinite(x)) fail(std::string(what) + " is not finite");
-    return x;
   }
 
   std::string_view body_;
@@ -214,7 +210,15 @@ PolygonMesh readBody(const PlyHeader& header, const MeshLayout& layout, Body& bo
           for (std::int64_t k = 0; k < n; ++k) body.value(property.type, "list item");
         }
       }
-      if (isVertex) coordinates.insert(coordinates.end(), point, point + 3);
+      if (isVertex) {
+        // Only coordinates must be finite: a NaN in a property the mesh does not use is not an error.
+        for (int a = 0; a < 3; ++a) {
+          if (!std::isfinite(point[a])) {
+            body.fail("vertex " + std::to_string(i) + ": coordinate " + static_cast<char>('x' + a) + " is not finite");
+          }
+        }
+        coordinates.insert(coordinates.end(), point, point + 3);
+      }
     }
   }
   if (!body.atEnd()) {

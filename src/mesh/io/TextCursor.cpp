@@ -109,7 +109,7 @@ void TextCursor::failAt(std::size_t line, const std::string& message) const {
   throwBadInput(source_ + ":" + std::to_string(line) + ": " + message);
 }
 
-double TextCursor::toDouble(std::string_view token, const char* what) const {
+double TextCursor::toDouble(std::string_view token, const char* what, bool allowNonFinite) const {
   const std::string_view digits = withoutPlus(token);
   double value = 0.0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
@@ -120,7 +120,7 @@ double TextCursor::toDouble(std::string_view token, const char* what) const {
   if (ec == std::errc::result_out_of_range) {
     fail(std::string(what) + " " + quoted(token) + " is out of the range of double precision");
   }
-  if (!std::isfinite(value)) fail(std::string(what) + " " + quoted(token) + " is not finite");
+  if (!allowNonFinite && !std::isfinite(value)) fail(std::string(what) + " " + quoted(token) + " is not finite");
   return value;
 }
 

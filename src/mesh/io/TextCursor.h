@@ -39,8 +39,9 @@ class TextCursor {
   [[noreturn]] void fail(const std::string& message) const;
   [[noreturn]] void failAt(std::size_t line, const std::string& message) const;
 
-  /// Parse a whole token as a finite double (what: used in messages, e.g. "coordinate").
-  double toDouble(std::string_view token, const char* what) const;
+  /// Parse a whole token as a double (what: used in messages, e.g. "coordinate"); NaN
+  /// and Inf are refused unless `allowNonFinite`.
+  double toDouble(std::string_view token, const char* what, bool allowNonFinite = false) const;
   /// Parse a whole token as an integer (optionally signed).
   std::int64_t toInteger(std::string_view token, const char* what) const;
 

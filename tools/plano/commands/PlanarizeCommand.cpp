@@ -1,5 +1,5 @@
 // plano planarize MESH -o OUT [--tolerance PERCENT] [--closeness W] [--fixed FILE]
-//   [--method gauss-newton|anderson|shapeup] [--max-iterations N] [--report R.json]
+//   [--method gauss-newton|guided|anderson|shapeup] [--max-iterations N] [--report R.json]
 //   [--keep-partial] [--in-place]
 // Moves the vertices so that every face is planar within the tolerance (papers' measure,
 // max over faces). Not reaching it within the cap exits with 4 and writes no mesh unless
@@ -67,9 +67,10 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--fixed", options->fixed, "Constraints JSON whose \"fixed\" vertices keep their positions");
-  app.add_option("--method", options->method, "gauss-newton (fast), anderson, or shapeup (reference)")
+  app.add_option("--method", options->method,
+                 "gauss-newton (fastest), guided (plane unknowns), anderson (accelerated shapeup), shapeup (reference)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"gauss-newton", "anderson", "shapeup"}));
+      ->check(CLI::IsMember({"gauss-newton", "guided", "anderson", "shapeup"}));
   app.add_option("--max-iterations", options->maxIterations, "Iteration cap")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));

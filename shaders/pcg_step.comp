@@ -1,0 +1,53 @@
+#version 450
+// One PCG update for m right-hand sides (n x m column-major), with the step length
+// alpha = (r.z) / (p.q) of each column read from the device's scalars, so that no scalar
+// travels to the host: X += alpha P, R -= alpha Q, Z = Dinv R (Jacobi preconditioner),
+// and in the same pass the first-pass partial sums of the new r.z (finished by la_reduce).
+// Dispatch: the dot products' fixed workgroup count in x, one row of groups per column.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = PLANO_GROUP_SIZE) in;
+
+layout(std430, binding = 0) readonly buffer P { double p[]; };
+layout(std430, binding = 1) readonly buffer Q { double q[]; };
+layout(std430, binding = 2) buffer X { double x[]; };
+layout(std430, binding = 3) buffer R { double r[]; };
+layout(std430, binding = 4) writeonly buffer Z { double z[]; };
+layout(std430, binding = 5) readonly buffer InverseDiagonal { double inverseDiagonal[]; };
+layout(std430, binding = 6) readonly buffer Scalars { double scalars[]; };
+layout(std430, binding = 7) writeonly buffer Partial { double partial[]; };
+
+layout(push_constant) uniform Push {
+  uint n;
+  uint m;
+  uint slotRz;  // r.z of the current iterate
+  uint slotPq;  // p.q
+} pc;
+
+shared double sums[PLANO_GROUP_SIZE];
+
+void main() {
+  const uint column = gl_WorkGroupID.y;
+  const uint base = column * pc.n;
+  const double pq = scalars[pc.slotPq * pc.m + column];
+  // A converged column (r = 0) gives p.q = 0: stand still instead of dividing by zero.
+  const double alpha = pq != 0.0 ? scalars[pc.slotRz * pc.m + column] / pq : 0.0;
+  double rz = 0.0;
+  GRID_STRIDE_LOOP(i, pc.n) {
+    x[base + i] += alpha * p[base + i];
+    const double ri = r[base + i] - alpha * q[base + i];
+    const double zi = inverseDiagonal[i] * ri;
+    r[base + i] = ri;
+    z[base + i] = zi;
+    rz += ri * zi;
+  }
+  const uint lane = gl_LocalInvocationID.x;
+  sums[lane] = rz;
+  barrier();
+  for (uint width = PLANO_GROUP_SIZE / 2; width > 0; width /= 2) {
+    if (lane < width) sums[lane] += sums[lane + width];
+    barrier();
+  }
+  if (lane == 0) partial[column * gl_NumWorkGroups.x + gl_WorkGroupID.x] = sums[0];
+}

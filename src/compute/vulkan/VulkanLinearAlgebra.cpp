@@ -1,0 +1,170 @@
+#include "compute/vulkan/VulkanLinearAlgebra.h"
+
+#include <algorithm>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct SpmvPush {
+  std::uint32_t rows, cols;
+};
+struct DotPush {
+  std::uint32_t n;
+};
+struct ReducePush {
+  std::uint32_t groups, m, slot;
+};
+struct AxpbyPush {
+  std::uint32_t count, pad;
+  double a, b;
+};
+struct ScalePush {
+  std::uint32_t n, m;
+};
+struct CountPush {
+  std::uint32_t count;
+};
+
+void requireSameShape(const DeviceVectors& a, const DeviceVectors& b, const char* operation) {
+  if (a.n() != b.n() || a.m() != b.m()) {
+    throwUsage(std::string(operation) + ": vector blocks of " + std::to_string(a.n()) + " x " +
+               std::to_string(a.m()) + " and " + std::to_string(b.n()) + " x " + std::to_string(b.m()));
+  }
+}
+
+std::uint32_t checkedCount(std::size_t count, const char* what) {
+  if (count > 0xffffffffu) throwDevice(std::string("Vulkan: ") + what + " has more than 2^32 entries");
+  return static_cast<std::uint32_t>(count);
+}
+
+}  // namespace
+
+DeviceCsrMatrix::DeviceCsrMatrix(Context& context, const compute::SparseMatrix& A)
+    : rows_(checkedCount(A.rows(), "the matrix")),
+      cols_(checkedCount(A.cols(), "the matrix")),
+      rowOffsets_(context, A.rows() + 1, MemoryClass::Device, "CSR row offsets"),
+      columns_(context, A.nonZeros(), MemoryClass::Device, "CSR column indices"),
+      values_(context, A.nonZeros(), MemoryClass::Device, "CSR values") {
+  if (!A.isCompressed()) throwUsage("DeviceCsrMatrix: the matrix must be compressed (makeCompressed())");
+  const std::size_t range = context.info().maxStorageBufferRange;
+  if (static_cast<std::size_t>(A.nonZeros()) * sizeof(double) > range) {
+    throwDevice("Vulkan: a matrix of " + std::to_string(A.nonZeros()) +
+                " non-zeros exceeds the device's storage-buffer range of " + std::to_string(range) + " bytes");
+  }
+  rowOffsets_.upload({A.outerIndexPtr(), static_cast<std::size_t>(A.rows()) + 1});
+  columns_.upload({A.innerIndexPtr(), static_cast<std::size_t>(A.nonZeros())});
+  values_.upload({A.valuePtr(), static_cast<std::size_t>(A.nonZeros())});
+}
+
+DeviceVectors::DeviceVectors(Context& context, std::uint32_t n, std::uint32_t m, const char* what)
+    : n_(n), m_(m), data_(context, static_cast<std::size_t>(n) * m, MemoryClass::Device, what) {
+  // Column c of a block is workgroup row c of the dispatches.
+  if (m > context.info().maxWorkGroupCount[1]) {
+    throwDevice(std::string("Vulkan: ") + what + " has " + std::to_string(m) + " columns, more than the device's " +
+                std::to_string(context.info().maxWorkGroupCount[1]) + " workgroups per dispatch row");
+  }
+  if (static_cast<std::size_t>(n) * m * sizeof(double) > context.info().maxStorageBufferRange) {
+    throwDevice(std::string("Vulkan: ") + what + " (" + std::to_string(n) + " x " + std::to_string(m) +
+                ") exceeds the device's storage-buffer range");
+  }
+}
+
+void DeviceVectors::upload(const Eigen::MatrixXd& values) {
+  if (values.rows() != n_ || values.cols() != m_) throwUsage("DeviceVectors::upload: shape mismatch");
+  data_.upload({values.data(), static_cast<std::size_t>(values.size())});
+}
+
+void DeviceVectors::download(Eigen::MatrixXd& values) const {
+  values.resize(n_, m_);
+  data_.download({values.data(), static_cast<std::size_t>(values.size())});
+}
+
+DeviceScalars::DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN)
+    : slots_(slots),
+      m_(m),
+      // Each thread of the first pass sums at least four entries; 1024 groups keep the
+      // second pass (one workgroup per column) short.
+      groups_(std::clamp<std::uint32_t>((maxN + 4 * kWorkGroupSize - 1) / (4 * kWorkGroupSize), 1, 1024)),
+      values_(context, static_cast<std::size_t>(slots) * m, MemoryClass::Device, "device scalars"),
+      partial_(context, static_cast<std::size_t>(groups_) * m, MemoryClass::Device, "partial sums") {
+  groups_ = std::min(groups_, context.info().maxWorkGroupCount[0]);  // the kernels stride over the rest
+}
+
+std::vector<double> DeviceScalars::read() const {
+  std::vector<double> all(static_cast<std::size_t>(slots_) * m_);
+  values_.download(all);
+  return all;
+}
+
+LinearAlgebra::LinearAlgebra(Context& context)
+    : context_(context),
+      spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
+      dot_(context, "la_dot", 3, sizeof(DotPush)),
+      reduce_(context, "la_reduce", 2, sizeof(ReducePush)),
+      axpby_(context, "la_axpby", 2, sizeof(AxpbyPush)),
+      scaleRows_(context, "la_scale_rows", 3, sizeof(ScalePush)),
+      clamp_(context, "la_clamp", 4, sizeof(CountPush)) {}
+
+void LinearAlgebra::spmv(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceVectors& X, DeviceVectors& Y) {
+  if (X.n() != A.cols() || Y.n() != A.rows() || X.m() != Y.m()) {
+    throwUsage("spmv: a " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) + " matrix times " +
+               std::to_string(X.n()) + " x " + std::to_string(X.m()) + " into " + std::to_string(Y.n()) + " x " +
+               std::to_string(Y.m()));
+  }
+  sequence.dispatch(spmv_, {A.rowOffsets(), A.columns(), A.values(), X.data(), Y.data()},
+                    SpmvPush{A.rows(), A.cols()}, groupsFor(context_, A.rows()), X.m());
+  sequence.barrier();
+}
+
+void LinearAlgebra::dot(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& Y, DeviceScalars& scalars,
+                        std::uint32_t slot) {
+  requireSameShape(X, Y, "dot");
+  if (scalars.m() != X.m() || slot >= scalars.slots_) throwUsage("dot: scalars do not match the vectors");
+  // The same number of groups for every n keeps the partial buffer's layout fixed.
+  sequence.dispatch(dot_, {X.data(), Y.data(), scalars.partial_}, DotPush{X.n()}, scalars.groups_, X.m());
+  sequence.barrier();
+  reduce(sequence, scalars, slot);
+}
+
+void LinearAlgebra::reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot) {
+  if (slot >= scalars.slots_) throwUsage("reduce: slot " + std::to_string(slot) + " out of range");
+  sequence.dispatch(reduce_, {scalars.partial_, scalars.values_}, ReducePush{scalars.groups_, scalars.m_, slot},
+                    scalars.m_);
+  sequence.barrier();
+}
+
+void LinearAlgebra::axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y) {
+  requireSameShape(X, Y, "axpby");
+  const std::uint32_t count = X.n() * X.m();
+  sequence.dispatch(axpby_, {X.data(), Y.data()}, AxpbyPush{count, 0, a, b}, groupsFor(context_, count));
+  sequence.barrier();
+}
+
+void LinearAlgebra::scaleRows(Sequence& sequence, const Array<double>& d, const DeviceVectors& X, DeviceVectors& Y) {
+  requireSameShape(X, Y, "scaleRows");
+  if (d.count() != X.n()) throwUsage("scaleRows: diagonal of " + std::to_string(d.count()) + " entries");
+  sequence.dispatch(scaleRows_, {d, X.data(), Y.data()}, ScalePush{X.n(), X.m()},
+                    groupsFor(context_, static_cast<std::size_t>(X.n()) * X.m()));
+  sequence.barrier();
+}
+
+void LinearAlgebra::clamp(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& L, const DeviceVectors& U,
+                          DeviceVectors& Y) {
+  requireSameShape(X, L, "clamp");
+  requireSameShape(X, U, "clamp");
+  requireSameShape(X, Y, "clamp");
+  const std::uint32_t count = X.n() * X.m();
+  sequence.dispatch(clamp_, {X.data(), L.data(), U.data(), Y.data()}, CountPush{count}, groupsFor(context_, count));
+  sequence.barrier();
+}
+
+void LinearAlgebra::copy(Sequence& sequence, const DeviceVectors& X, DeviceVectors& Y) {
+  requireSameShape(X, Y, "copy");
+  sequence.copy(X.data(), Y.data(), static_cast<std::size_t>(X.n()) * X.m() * sizeof(double));
+  sequence.barrier();
+}
+
+}  // namespace plano::vk

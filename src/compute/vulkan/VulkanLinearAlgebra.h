@@ -1,0 +1,117 @@
+#pragma once
+// Sparse and dense linear algebra on the device, the building blocks of the global steps
+// (the PCG solve here, a device ADMM later): CSR matrix-vector products, column-wise dot
+// products with two-pass workgroup reductions, axpby, row scaling and box projection.
+//
+// Vectors come in blocks of m columns of n entries (column-major), so that the three
+// coordinates of a mesh-sized unknown are one dispatch. Operations are *recorded* into a
+// Sequence (each followed by a barrier) and run when the sequence runs; scalars such as
+// dot products stay on the device in DeviceScalars until the host asks for them.
+#include <cstdint>
+#include <vector>
+
+#include "compute/Backend.h"
+#include "compute/vulkan/VulkanSequence.h"
+
+namespace plano::vk {
+
+/// A compressed-row matrix on the device (uploaded once).
+class DeviceCsrMatrix {
+ public:
+  /// Upload A (compressed; throws Error(Device) when a buffer exceeds the device's range).
+  DeviceCsrMatrix(Context& context, const compute::SparseMatrix& A);
+  std::uint32_t rows() const { return rows_; }
+  std::uint32_t cols() const { return cols_; }
+  const Array<std::int32_t>& rowOffsets() const { return rowOffsets_; }
+  const Array<std::int32_t>& columns() const { return columns_; }
+  const Array<double>& values() const { return values_; }
+
+ private:
+  std::uint32_t rows_;
+  std::uint32_t cols_;
+  Array<std::int32_t> rowOffsets_;
+  Array<std::int32_t> columns_;
+  Array<double> values_;
+};
+
+/// m column vectors of n entries each, column-major, on the device.
+class DeviceVectors {
+ public:
+  DeviceVectors(Context& context, std::uint32_t n, std::uint32_t m, const char* what);
+  std::uint32_t n() const { return n_; }
+  std::uint32_t m() const { return m_; }
+  Array<double>& data() { return data_; }
+  const Array<double>& data() const { return data_; }
+  /// Upload / download an n x m Eigen matrix (sizes must match).
+  void upload(const Eigen::MatrixXd& values);
+  void download(Eigen::MatrixXd& values) const;
+
+ private:
+  std::uint32_t n_;
+  std::uint32_t m_;
+  Array<double> data_;
+};
+
+/// `slots` x m scalars on the device (slot s of column c at s * m + c), plus the scratch
+/// of the dot products' first pass for vectors of up to maxN entries.
+class DeviceScalars {
+ public:
+  DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN);
+  std::uint32_t m() const { return m_; }
+  /// Copy all slots to the host (after the sequence that wrote them ran).
+  std::vector<double> read() const;
+  double at(const std::vector<double>& all, std::uint32_t slot, std::uint32_t column) const {
+    return all[slot * m_ + column];
+  }
+  /// The device buffer, for kernels that read scalars (e.g. PCG step lengths).
+  const Array<double>& values() const { return values_; }
+  /// First-pass scratch and its workgroup count, for fused kernels that produce partial
+  /// sums themselves (finished with LinearAlgebra::reduce).
+  const Array<double>& partial() const { return partial_; }
+  std::uint32_t groups() const { return groups_; }
+
+ private:
+  friend class LinearAlgebra;
+  std::uint32_t slots_;
+  std::uint32_t m_;
+  std::uint32_t groups_;  ///< Workgroups (partial sums per column) of the first pass.
+  Array<double> values_;
+  Array<double> partial_;
+};
+
+class LinearAlgebra {
+ public:
+  /// Builds the pipelines (once).
+  explicit LinearAlgebra(Context& context);
+
+  /// Y = A X (X: A.cols x m, Y: A.rows x m).
+  void spmv(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceVectors& X, DeviceVectors& Y);
+  /// scalars[slot][c] = X(:, c) . Y(:, c).
+  void dot(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& Y, DeviceScalars& scalars,
+           std::uint32_t slot);
+  /// Second pass of a dot product whose partial sums are already in scalars.partial():
+  /// scalars[slot][c] = sum of the column's partial sums.
+  void reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot);
+  /// Y = a X + b Y.
+  void axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y);
+  /// Y = diag(d) X, d of n entries applied to every column.
+  void scaleRows(Sequence& sequence, const Array<double>& d, const DeviceVectors& X, DeviceVectors& Y);
+  /// Y = min(max(X, L), U) entry by entry.
+  void clamp(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& L, const DeviceVectors& U,
+             DeviceVectors& Y);
+  /// Y = X (a device copy).
+  void copy(Sequence& sequence, const DeviceVectors& X, DeviceVectors& Y);
+
+  Context& context() { return context_; }
+
+ private:
+  Context& context_;
+  Pipeline spmv_;
+  Pipeline dot_;
+  Pipeline reduce_;
+  Pipeline axpby_;
+  Pipeline scaleRows_;
+  Pipeline clamp_;
+};
+
+}  // namespace plano::vk

@@ -1,0 +1,186 @@
+#include "compute/vulkan/VulkanPcgSolver.h"
+
+#include <cmath>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct StepPush {
+  std::uint32_t n, m, slotRz, slotPq;
+};
+struct SpmvDotPush {
+  std::uint32_t n;
+};
+struct DirectionPush {
+  std::uint32_t n, m, slotNew, slotOld;
+};
+
+// Scalar slots (one value per column each).
+enum Slot : std::uint32_t { kRzEven = 0, kRzOdd, kPq, kRr, kBb, kSlots };
+
+std::uint32_t squareSize(const compute::SparseMatrix& A) {
+  if (A.rows() != A.cols()) {
+    throwNumerical("SPD solver: matrix is " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
+                   ", not square");
+  }
+  return static_cast<std::uint32_t>(A.rows());
+}
+
+std::vector<double> inverseDiagonalOf(const compute::SparseMatrix& A) {
+  std::vector<double> inverse(A.rows());
+  for (Eigen::Index r = 0; r < A.rows(); ++r) {
+    const double d = A.coeff(r, r);
+    if (!(d > 0.0)) {
+      throwNumerical("SPD solver: diagonal entry of row " + std::to_string(r) + " is " + std::to_string(d) +
+                     " (a symmetric positive definite matrix has a positive diagonal)");
+    }
+    inverse[r] = 1.0 / d;
+  }
+  return inverse;
+}
+
+}  // namespace
+
+struct PcgSolver::Workspace {
+  Workspace(Context& context, std::uint32_t n, std::uint32_t m)
+      : m(m),
+        b(context, n, m, "PCG right-hand sides"),
+        x(context, n, m, "PCG solution"),
+        r(context, n, m, "PCG residual"),
+        z(context, n, m, "PCG preconditioned residual"),
+        p(context, n, m, "PCG direction"),
+        q(context, n, m, "PCG A times direction"),
+        scalars(context, kSlots, m, n),
+        start(context),
+        block(context),
+        finish(context) {}
+  std::uint32_t m;
+  DeviceVectors b, x, r, z, p, q;
+  DeviceScalars scalars;
+  Sequence start;   ///< r = b - A x, z = M^-1 r, p = z, rz, bb, rr
+  Sequence block;   ///< kCheckInterval iterations, then rr
+  Sequence finish;  ///< true residual r = b - A x and rr
+};
+
+PcgSolver::PcgSolver(Context& context, const compute::SparseMatrix& A, const compute::LinearSolverSettings& settings)
+    : context_(context),
+      settings_(settings),
+      n_(squareSize(A)),
+      algebra_(context),
+      matrix_(context, A),
+      inverseDiagonal_(context, n_, MemoryClass::Device, "inverse diagonal"),
+      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(SpmvDotPush)),
+      step_(context, "pcg_step", 8, sizeof(StepPush)),
+      direction_(context, "pcg_direction", 3, sizeof(DirectionPush)) {
+  inverseDiagonal_.upload(inverseDiagonalOf(A));
+}
+
+PcgSolver::~PcgSolver() = default;
+
+void PcgSolver::prepare(std::uint32_t m) {
+  if (workspace_ && workspace_->m == m) return;
+  workspace_ = std::make_unique<Workspace>(context_, n_, m);
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  const std::uint32_t count = n_ * m;
+
+  auto residual = [&](Sequence& s) {  // r = b - A x, rr = r.r
+    la.spmv(s, matrix_, w.x, w.q);
+    la.copy(s, w.b, w.r);
+    la.axpby(s, -1.0, w.q, 1.0, w.r);
+    la.dot(s, w.r, w.r, w.scalars, kRr);
+  };
+
+  w.start.begin();
+  residual(w.start);
+  la.scaleRows(w.start, inverseDiagonal_, w.r, w.z);
+  la.copy(w.start, w.z, w.p);
+  la.dot(w.start, w.r, w.z, w.scalars, kRzEven);
+  la.dot(w.start, w.b, w.b, w.scalars, kBb);
+  w.start.end();
+
+  w.block.begin();
+  for (int iteration = 0; iteration < kCheckInterval; ++iteration) {
+    // r.z of the current iterate alternates between two slots, so that the direction
+    // update can read both the old and the new value without a copy.
+    const std::uint32_t current = iteration % 2 == 0 ? kRzEven : kRzOdd;
+    const std::uint32_t next = iteration % 2 == 0 ? kRzOdd : kRzEven;
+    // Five dispatches an iteration: q = A p with the partial sums of p.q, their reduction,
+    // the x/r/z update with the partial sums of the new r.z, their reduction, and p.
+    w.block.dispatch(spmvDot_,
+                     {matrix_.rowOffsets(), matrix_.columns(), matrix_.values(), w.p.data(), w.q.data(),
+                      w.scalars.partial()},
+                     SpmvDotPush{n_}, w.scalars.groups(), m);
+    w.block.barrier();
+    la.reduce(w.block, w.scalars, kPq);
+    w.block.dispatch(step_,
+                     {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseDiagonal_,
+                      w.scalars.values(), w.scalars.partial()},
+                     StepPush{n_, m, current, kPq}, w.scalars.groups(), m);
+    w.block.barrier();
+    la.reduce(w.block, w.scalars, next);
+    w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},
+                     DirectionPush{n_, m, next, current}, groupsFor(context_, count));
+    w.block.barrier();
+  }
+  la.dot(w.block, w.r, w.r, w.scalars, kRr);
+  w.block.end();
+
+  w.finish.begin();
+  residual(w.finish);
+  w.finish.end();
+}
+
+compute::LinearSolveInfo PcgSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+  if (B.rows() != n_) {
+    throwUsage("PCG solve: right-hand side has " + std::to_string(B.rows()) + " rows for a " + std::to_string(n_) +
+               " x " + std::to_string(n_) + " matrix");
+  }
+  const auto m = static_cast<std::uint32_t>(B.cols());
+  compute::LinearSolveInfo info;
+  info.iterations = 0;
+  if (m == 0) return info;
+  if (X.rows() != B.rows() || X.cols() != B.cols()) X = Eigen::MatrixXd::Zero(B.rows(), B.cols());
+  prepare(m);
+  Workspace& w = *workspace_;
+  w.b.upload(B);
+  w.x.upload(X);
+
+  const double tolerance2 = settings_.relativeTolerance * settings_.relativeTolerance;
+  auto converged = [&](const std::vector<double>& s) {
+    for (std::uint32_t c = 0; c < m; ++c) {
+      const double rr = w.scalars.at(s, kRr, c);
+      if (!std::isfinite(rr)) throwNumerical("PCG solve: the residual of column " + std::to_string(c) + " is NaN");
+      if (rr > tolerance2 * w.scalars.at(s, kBb, c)) return false;
+    }
+    return true;
+  };
+
+  w.start.run();
+  const std::vector<double> first = w.scalars.read();
+  std::vector<double> bb(m);
+  for (std::uint32_t c = 0; c < m; ++c) bb[c] = w.scalars.at(first, kBb, c);
+  bool done = converged(first);
+  while (!done && info.iterations < settings_.maxIterations) {
+    w.block.run();
+    info.iterations += kCheckInterval;
+    done = converged(w.scalars.read());
+  }
+
+  w.finish.run();
+  const std::vector<double> last = w.scalars.read();
+  w.x.download(X);
+  info.relativeResidual = 0.0;
+  for (std::uint32_t c = 0; c < m; ++c) {
+    const double rr = w.scalars.at(last, kRr, c);
+    const double relative = bb[c] > 0.0 ? std::sqrt(rr / bb[c]) : std::sqrt(rr);
+    info.relativeResidual = std::max(info.relativeResidual, relative);
+  }
+  info.converged = done && std::isfinite(info.relativeResidual);
+  return info;
+}
+
+}  // namespace plano::vk

@@ -1,0 +1,214 @@
+#include "projective/MultiresCoarseStep.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/Error.h"
+
+namespace plano::projective {
+namespace {
+
+/// Below this |shat| a point is mapped (numerically) to the plane at infinity.
+constexpr double kMinimumReciprocalScale = 1e-10;
+
+std::string number(double value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+compute::SparseMatrix smoothnessMatrix(const ShapeSpace& space, double alpha) {
+  const Index n = 4 * space.faceCount();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Index i = 0; i < n; ++i) entries.emplace_back(i, i, 1.0);
+  if (alpha > 0.0) {
+    for (const auto& [f, g] : space.adjacentFaces()) {
+      for (Index r = 0; r < 4; ++r) {
+        entries.emplace_back(4 * f + r, 4 * f + r, alpha);
+        entries.emplace_back(4 * g + r, 4 * g + r, alpha);
+        entries.emplace_back(4 * f + r, 4 * g + r, -alpha);
+        entries.emplace_back(4 * g + r, 4 * f + r, -alpha);
+      }
+    }
+  }
+  compute::SparseMatrix P(n, n);
+  P.setFromTriplets(entries.begin(), entries.end());
+  return P;
+}
+
+}  // namespace
+
+MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> fixed,
+                                       std::vector<MapPointConstraint> handles, const GlobalStepSettings& settings)
+    : backend_(backend), space_(space), handles_(std::move(handles)), settings_(settings), rho_(settings.qp.rho) {
+  if (!(settings_.smoothness >= 0.0) || !std::isfinite(settings_.smoothness)) {
+    throwUsage("coarse global step: smoothness must be a finite number >= 0, got " + number(settings_.smoothness));
+  }
+  if (!(settings_.epsilonGrowth > 1.0)) throwUsage("coarse global step: epsilon growth must exceed 1");
+  std::vector<char> isFixed(space_.vertexCount(), 0);
+  for (const Index v : fixed) {
+    if (v < 0 || v >= space_.vertexCount()) {
+      throwBadInput("coarse global step: fixed vertex " + std::to_string(v) + " is out of range (" +
+                    std::to_string(space_.vertexCount()) + " vertices)");
+    }
+    if (isFixed[v]) throwBadInput("coarse global step: vertex " + std::to_string(v) + " is fixed twice");
+    isFixed[v] = 1;
+  }
+  for (MapPointConstraint& h : handles_) {
+    if (h.face < 0 || h.face >= space_.faceCount()) {
+      throwBadInput("coarse global step: handle " + std::to_string(h.handle) + " is attached to face " +
+                    std::to_string(h.face) + ", out of range (" + std::to_string(space_.faceCount()) + " faces)");
+    }
+    if (!h.point.allFinite() || !h.target.allFinite()) {
+      throwBadInput("coarse global step: handle " + std::to_string(h.handle) + " has a non-finite point or target");
+    }
+    h.point = space_.normalization().toNormalized(Eigen::RowVector3d(h.point.transpose())).transpose();
+    h.target = space_.normalization().toNormalized(Eigen::RowVector3d(h.target.transpose())).transpose();
+  }
+
+  const auto& offsets = space_.vertexCornerOffsets();
+  const auto& corners = space_.cornersOfVertex();
+  for (Index v = 0; v < space_.vertexCount(); ++v) {
+    const Index begin = offsets[v];
+    const Index end = offsets[v + 1];
+    if (isFixed[v]) {
+      for (Index k = begin; k < end; ++k) rows_.push_back({RowKind::Fixed, v, corners[k], -1, -1});
+    } else {
+      for (Index k = begin + 1; k < end; ++k) rows_.push_back({RowKind::Compatibility, v, corners[begin], corners[k], -1});
+    }
+  }
+  for (std::size_t h = 0; h < handles_.size(); ++h) {
+    rows_.push_back({RowKind::MapPoint, -1, -1, -1, static_cast<Index>(h)});
+  }
+  P_ = smoothnessMatrix(space_, settings_.smoothness);
+}
+
+GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& targets, FaceMaps& result) {
+  const Index faceCount = space_.faceCount();
+  if (static_cast<Index>(targets.size()) != faceCount) {
+    throwUsage("coarse global step: " + std::to_string(targets.size()) + " target maps for " +
+               std::to_string(faceCount) + " faces");
+  }
+  for (Index f = 0; f < faceCount; ++f) {
+    if (!targets[f].allFinite()) {
+      throwNumerical("coarse global step: the target map of face " + std::to_string(f) + " is not finite");
+    }
+  }
+  GlobalStepInfo info;
+  const std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  for (Index c = 0; c < space_.cornerCount(); ++c) {
+    if (shat[c] <= 0.0) ++info.nonPositiveScales;
+    if (!(std::abs(shat[c]) > kMinimumReciprocalScale)) {
+      throwNumerical("coarse global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
+                     " sends vertex " + std::to_string(space_.faces().indices()[c]) + " to infinity");
+    }
+  }
+
+  const auto m = static_cast<Eigen::Index>(rows_.size());
+  const Index n = 4 * faceCount;
+  const Positions& base = space_.basePositions();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(rows_.size() * 8);
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
+  std::vector<char> relaxed(m, 0);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Row& row = rows_[r];
+    if (row.kind == RowKind::MapPoint) {
+      const MapPointConstraint& h = handles_[row.handle];
+      const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
+      const double scale = p.dot(targets[h.face].col(3).transpose());
+      if (!(std::abs(scale) > kMinimumReciprocalScale)) {
+        throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
+                       std::to_string(h.handle) + " to infinity");
+      }
+      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * h.face + k, p[k] / scale);
+      d.row(r) = h.target.transpose();
+      continue;
+    }
+    const Eigen::RowVector4d p = homogeneous(base.row(row.vertex));
+    const Index fa = space_.cornerFace(row.cornerA);
+    for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fa + k, p[k] / shat[row.cornerA]);
+    if (row.kind == RowKind::Compatibility) {
+      relaxed[r] = 1;
+      const Index fb = space_.cornerFace(row.cornerB);
+      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fb + k, -p[k] / shat[row.cornerB]);
+    } else {
+      d.row(r) = base.row(row.vertex);
+    }
+  }
+  compute::SparseMatrix C(m, n);
+  C.setFromTriplets(entries.begin(), entries.end());
+
+  Eigen::MatrixXd T(n, 3);
+  for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
+  const Eigen::MatrixXd q = -T;
+  info.initialViolation = m > 0 ? (C * T - d).cwiseAbs().maxCoeff() : 0.0;
+
+  // The paper's schedule (§5): eps_0 = fraction * violation, times the growth until the
+  // relaxed problem is solved; optionally eps = 0 first.
+  std::vector<double> schedule;
+  const double eps0 = settings_.initialEpsilonFraction * info.initialViolation;
+  if (settings_.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
+  if (eps0 > 0.0) {
+    double eps = eps0;
+    for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
+  }
+
+  BoxQpSettings qpSettings = settings_.qp;
+  qpSettings.rho = rho_;
+  BoxQpSolver qp(backend_, P_, C, qpSettings);
+  Eigen::MatrixXd x = T;
+  Eigen::MatrixXd y;
+  bool solved = false;
+  for (const double eps : schedule) {
+    Eigen::MatrixXd lower = d;
+    Eigen::MatrixXd upper = d;
+    for (Eigen::Index r = 0; r < m; ++r) {
+      if (relaxed[r]) {
+        lower.row(r).array() -= eps;
+        upper.row(r).array() += eps;
+      }
+    }
+    Eigen::MatrixXd xTry = x;
+    Eigen::MatrixXd yTry = y;
+    const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
+    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
+    info.admmIterations += qpInfo.iterations;
+    info.factorizations += qpInfo.factorizations;
+    rho_ = qpInfo.rho;
+    if (qpInfo.status == BoxQpStatus::NonFinite) {
+      throwNumerical("coarse global step: the ADMM iteration produced a non-finite value (eps " + number(eps) + ")");
+    }
+    x = xTry;
+    y = yTry;  // the next eps starts from this attempt
+    if (qpInfo.status == BoxQpStatus::Solved) {
+      info.epsilon = eps;
+      info.polished = qpInfo.polished;
+      info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
+      solved = true;
+      break;
+    }
+  }
+  if (!solved) {
+    throwNumerical("coarse global step: no feasible relaxation found up to eps " + number(schedule.back()) +
+                   " (initial violation " + number(info.initialViolation) + ")");
+  }
+
+  if (m > 0) {
+    const Eigen::MatrixXd residual = (C * x - d).cwiseAbs();
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const double value = residual.row(r).maxCoeff();
+      info.constraintResidual = std::max(info.constraintResidual, value);
+      if (!relaxed[r]) info.positionalResidual = std::max(info.positionalResidual, value);
+    }
+  }
+  result.maps.resize(faceCount);
+  for (Index f = 0; f < faceCount; ++f) {
+    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
+    result.maps[f].col(3) = targets[f].col(3);
+  }
+  result.reciprocalScales = shat;
+  return info;
+}
+
+}  // namespace plano::projective

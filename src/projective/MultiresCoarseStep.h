@@ -1,0 +1,57 @@
+#pragma once
+// Global step of the coarse level of multi-resolution editing (projective-maps paper,
+// §6.2): Eq. 4 with the ε relaxation, where the positional constraints are
+//  - fixed vertices of the coarse level, held at their base positions (for an
+//    approximating scheme these are the coarse positions, not the fine ones, §6.5), and
+//  - handles attached to the maps of coarse faces: (p, 1) A_f proportional to (q, 1) for a
+//    point p of the ambient space (the handle's fine position) and its target q.
+// GlobalStep (GlobalStep.h) constrains mesh vertices only; this step adds the ambient
+// point rows and otherwise follows the same structure: scale factors induced by the
+// targets and held fixed (for a point, shat = (p, 1) T_f[:, 3]), fourth columns taken from
+// the targets, three QPs for columns 0..2 sharing one matrix (BoxQp.h), the paper's ε
+// schedule on the compatibility rows only.
+#include <vector>
+
+#include "compute/Backend.h"
+#include "projective/GlobalStep.h"
+#include "projective/MultiresConstraints.h"
+#include "projective/ShapeSpace.h"
+
+namespace plano::projective {
+
+class MultiresCoarseStep {
+ public:
+  /// Precompute the row layout and P = I + alpha L.
+  ///   space    in: shape space of the coarse level (kept by reference).
+  ///   fixed    in: fixed vertices of the level (unique).
+  ///   handles  in: map-point constraints in world coordinates (faces of the level).
+  /// Throws Error(BadInput) for an out-of-range or repeated vertex or face, a non-finite
+  /// point or target.
+  MultiresCoarseStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> fixed,
+                     std::vector<MapPointConstraint> handles, const GlobalStepSettings& settings = {});
+
+  /// Project the target maps (normalized coordinates, #F) onto the compatible maps that
+  /// satisfy the constraints. result: out, the maps and reciprocal scales. Throws
+  /// Error(Numerical) as GlobalStep::solve does.
+  GlobalStepInfo solve(const std::vector<Eigen::Matrix4d>& targets, FaceMaps& result);
+
+ private:
+  enum class RowKind { Compatibility, Fixed, MapPoint };
+  struct Row {
+    RowKind kind;
+    Index vertex;   ///< Compatibility and fixed rows.
+    Index cornerA;  ///< Compatibility and fixed rows.
+    Index cornerB;  ///< Compatibility rows.
+    Index handle;   ///< MapPoint rows: index into handles_.
+  };
+
+  compute::Backend& backend_;
+  const ShapeSpace& space_;
+  std::vector<MapPointConstraint> handles_;  ///< Points and targets in normalized coordinates.
+  GlobalStepSettings settings_;
+  compute::SparseMatrix P_;
+  std::vector<Row> rows_;
+  double rho_;
+};
+
+}  // namespace plano::projective

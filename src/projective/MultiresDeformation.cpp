@@ -1,0 +1,216 @@
+#include "projective/MultiresDeformation.h"
+
+#include <chrono>
+#include <string>
+
+#include "core/Error.h"
+#include "projective/Deformation.h"
+#include "projective/LocalStep.h"
+#include "projective/MultiresCoarseStep.h"
+#include "projective/ShapeSpace.h"
+
+namespace plano::projective {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double maxRowDistance(const Positions& a, const Positions& b) {
+  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
+}
+
+/// (x, 1) M = ((x - centre) / scale, 1): world to normalized coordinates as a 4x4 map in
+/// the row-vector convention, and its inverse.
+Eigen::Matrix4d toNormalizedMap(const Normalization& n) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() /= n.scale;
+  m.block<1, 3>(3, 0) = -n.centre / n.scale;
+  return m;
+}
+Eigen::Matrix4d toWorldMap(const Normalization& n) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() *= n.scale;
+  m.block<1, 3>(3, 0) = n.centre;
+  return m;
+}
+
+/// §6.3: every finest face takes the map of its ancestor on the coarse level, converted
+/// from the coarse level's normalized coordinates to the fine level's (same world map).
+std::vector<Eigen::Matrix4d> prolongMaps(const std::vector<Eigen::Matrix4d>& coarseMaps, const Normalization& coarse,
+                                         const Normalization& fine, const std::vector<Index>& ancestors) {
+  const Eigen::Matrix4d into = toWorldMap(fine) * toNormalizedMap(coarse);    // fine normalized -> coarse normalized
+  const Eigen::Matrix4d back = toWorldMap(coarse) * toNormalizedMap(fine);    // coarse normalized -> fine normalized
+  std::vector<Eigen::Matrix4d> converted(coarseMaps.size());
+  for (std::size_t f = 0; f < coarseMaps.size(); ++f) {
+    Eigen::Matrix4d m = into * coarseMaps[f] * back;
+    m /= m(3, 3);  // keep the normalization A(3, 3) = 1 of the shape space
+    converted[f] = m;
+  }
+  std::vector<Eigen::Matrix4d> prolonged(ancestors.size());
+  for (std::size_t g = 0; g < ancestors.size(); ++g) prolonged[g] = converted[ancestors[g]];
+  return prolonged;
+}
+
+void checkInput(const SubdivisionHierarchy& hierarchy, const std::vector<Positions>& positions,
+                const MultiresSettings& settings) {
+  const int finest = hierarchy.finestLevel();
+  if (static_cast<int>(positions.size()) != finest + 1) {
+    throwUsage("multires: " + std::to_string(positions.size()) + " position sets for " + std::to_string(finest + 1) +
+               " levels");
+  }
+  for (int l = 0; l <= finest; ++l) {
+    if (positions[l].rows() != hierarchy.vertexCount(l)) {
+      throwUsage("multires: level " + std::to_string(l) + " has " + std::to_string(positions[l].rows()) +
+                 " positions for " + std::to_string(hierarchy.vertexCount(l)) + " vertices");
+    }
+  }
+  if (settings.level < -1 || settings.level > finest) {
+    throwUsage("multires: level " + std::to_string(settings.level) + " is outside the hierarchy (0.." +
+               std::to_string(finest) + ", or -1 for the paper's rule)");
+  }
+  if (settings.maxCoarseIterations < 1) throwUsage("multires: at least one coarse iteration is needed");
+  if (!(settings.tolerance > 0.0)) throwUsage("multires: the tolerance must be positive");
+}
+
+/// Fixed vertices, then handles: the constrained vertices of the fine global step and
+/// their world positions.
+void fineConstraints(const PositionalConstraints& constraints, const Positions& finest, std::vector<Index>& vertices,
+                     Positions& targets) {
+  vertices.clear();
+  targets.resize(static_cast<Eigen::Index>(constraints.fixed.size() + constraints.handles.size()), 3);
+  for (const Index v : constraints.fixed) {
+    targets.row(static_cast<Eigen::Index>(vertices.size())) = finest.row(v);
+    vertices.push_back(v);
+  }
+  for (const Handle& h : constraints.handles) {
+    targets.row(static_cast<Eigen::Index>(vertices.size())) = h.position.transpose();
+    vertices.push_back(h.vertex);
+  }
+}
+
+/// Direct single-level deformation of the finest mesh (the rule chose it).
+void deformFinest(compute::Backend& backend, const PolygonMesh& mesh, const PositionalConstraints& constraints,
+                  const MultiresSettings& settings, MultiresResult& result) {
+  DeformationSettings direct;
+  direct.energy = settings.energy;
+  direct.maxIterations = settings.maxCoarseIterations;
+  direct.tolerance = settings.tolerance;
+  direct.planarityTolerance = settings.planarityTolerance;
+  direct.maxProjectionIterations = settings.maxProjectionIterations;
+  direct.global = settings.global;
+  direct.global.smoothness = 0.0;
+  const auto start = Clock::now();
+  const DeformationResult deformed = deform(backend, mesh, constraints, direct);
+  if (deformed.info.status == DeformationStatus::NumericalFailure) throwNumerical("multires: " + deformed.info.message);
+  result.positions = deformed.mesh.vertices;
+  result.info.coarseIterations = deformed.info.iterations;
+  for (const auto& it : deformed.info.history) {
+    result.info.coarseEpsilons.push_back(it.epsilon);
+    result.info.coarseDisplacements.push_back(it.displacement);
+  }
+  result.info.coarseSeconds = secondsSince(start);
+  if (deformed.info.status != DeformationStatus::Converged) result.info.status = MultiresStatus::MaxIterationsReached;
+}
+
+}  // namespace
+
+const char* toString(MultiresStatus status) {
+  switch (status) {
+    case MultiresStatus::Converged: return "converged";
+    case MultiresStatus::MaxIterationsReached: return "max_iterations_reached";
+  }
+  return "unknown";
+}
+
+MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierarchy& hierarchy,
+                              const std::vector<Positions>& positions, const PositionalConstraints& constraints,
+                              const MultiresSettings& settings) {
+  checkInput(hierarchy, positions, settings);
+  const auto start = Clock::now();
+  const int finest = hierarchy.finestLevel();
+  MultiresResult result;
+  MultiresInfo& info = result.info;
+  if (settings.level >= 0) {
+    info.level = settings.level;
+  } else {
+    info.levelChecks = checkDeformationLevels(hierarchy, constraints);
+    info.level = chooseDeformationLevel(hierarchy, constraints);
+  }
+  const int level = info.level;
+  const PolygonMesh fineMesh{positions[finest], hierarchy.faces(finest)};
+  info.coarseFaces = hierarchy.faces(level).size();
+  info.fineFaces = fineMesh.faceCount();
+
+  if (level == finest) {
+    deformFinest(backend, fineMesh, constraints, settings, result);
+  } else {
+    // Coarse deformation (§6.1 on M_k with the coarsened constraints of §6.2).
+    const auto coarseStart = Clock::now();
+    const CoarseConstraints coarse = coarsenConstraints(hierarchy, positions[finest], constraints, level);
+    const ShapeSpace coarseSpace(PolygonMesh{positions[level], hierarchy.faces(level)});
+    GlobalStepSettings coarseSettings = settings.global;
+    coarseSettings.smoothness = 0.0;
+    MultiresCoarseStep coarseStep(backend, coarseSpace, coarse.fixed, coarse.handles, coarseSettings);
+    Positions current = positions[level];
+    FaceMaps coarseMaps = coarseSpace.identityMaps();
+    bool converged = false;
+    const double coarseDiagonal = coarseSpace.normalization().scale;
+    for (int it = 0; it < settings.maxCoarseIterations && !converged; ++it) {
+      const LocalStepResult fit = fitFaceMaps(backend, coarseSpace, current);
+      const auto ideal = closestIdealMaps(backend, coarseSpace, fit.fits.maps, settings.energy);
+      const GlobalStepInfo step = coarseStep.solve(ideal, coarseMaps);
+      const Positions next = coarseSpace.positions(coarseMaps.maps);
+      const double displacement = maxRowDistance(next, current) / coarseDiagonal;
+      info.coarseEpsilons.push_back(step.epsilon);
+      info.coarseDisplacements.push_back(displacement);
+      ++info.coarseIterations;
+      current = next;
+      converged = displacement < settings.tolerance;
+    }
+    if (!converged) info.status = MultiresStatus::MaxIterationsReached;
+    info.coarseSeconds = secondsSince(coarseStart);
+
+    // Prolongation (§6.3) and the fine global step with the user's constraints.
+    const auto fineStart = Clock::now();
+    const ShapeSpace fineSpace(fineMesh);
+    const auto prolonged = prolongMaps(coarseMaps.maps, coarseSpace.normalization(), fineSpace.normalization(),
+                                       hierarchy.ancestorsOfFinestFaces(level));
+    std::vector<Index> constrained;
+    Positions targets;
+    fineConstraints(constraints, positions[finest], constrained, targets);
+    GlobalStepSettings fineSettings = settings.global;
+    fineSettings.smoothness = settings.smoothness;
+    GlobalStep fineStep(backend, fineSpace, constrained, fineSettings);
+    FaceMaps fineMaps;
+    info.fineStep = fineStep.solve(prolonged, targets, fineMaps);
+    result.positions = fineSpace.positions(fineMaps.maps);
+    // Only if eps > 0 left the faces above the bound: §5 projection iterations.
+    const double bound = std::max(settings.planarityTolerance, planarityStats(fineMesh).max);
+    for (int it = 0; it < settings.maxProjectionIterations &&
+                     planarityStats(PolygonMesh{result.positions, fineMesh.faces}).max > bound;
+         ++it) {
+      const LocalStepResult fit = fitFaceMaps(backend, fineSpace, result.positions);
+      fineStep.solve(fit.fits.maps, targets, fineMaps);
+      result.positions = fineSpace.positions(fineMaps.maps);
+      ++info.projectionIterations;
+    }
+    info.prolongationSeconds = secondsSince(fineStart);
+  }
+
+  info.planarity = planarityStats(PolygonMesh{result.positions, fineMesh.faces}, settings.planarityTolerance);
+  if (info.planarity.max > std::max(settings.planarityTolerance, planarityStats(fineMesh).max)) {
+    info.status = MultiresStatus::MaxIterationsReached;
+  }
+  for (const Index v : constraints.fixed) {
+    info.maxFixedError = std::max(info.maxFixedError, (result.positions.row(v) - positions[finest].row(v)).norm());
+  }
+  for (const Handle& h : constraints.handles) {
+    info.maxHandleError =
+        std::max(info.maxHandleError, (result.positions.row(h.vertex) - h.position.transpose()).norm());
+  }
+  info.seconds = secondsSince(start);
+  return result;
+}
+
+}  // namespace plano::projective

@@ -1,0 +1,118 @@
+#include "projective/PqSubdivision.h"
+
+#include <chrono>
+#include <string>
+
+#include "core/Error.h"
+#include "projective/LocalStep.h"
+#include "projective/ShapeSpace.h"
+
+namespace plano::projective {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double maxRowDistance(const Positions& a, const Positions& b) {
+  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
+}
+
+PlanarityStats planarityOf(compute::Backend& backend, const PolygonMesh& mesh, double tolerance) {
+  std::vector<double> values(mesh.faceCount());
+  backend.facePlanarity(mesh, values);
+  return summarizePlanarity(values, tolerance);
+}
+
+void checkSettings(const PqSubdivisionSettings& settings) {
+  if (settings.levels < 0) throwUsage("subdivision levels must be >= 0 (got " + std::to_string(settings.levels) + ")");
+  if (!(settings.planarityTolerance > 0.0)) throwUsage("subdivision: the planarity tolerance must be positive");
+  if (!(settings.changeTolerance > 0.0)) throwUsage("subdivision: the change tolerance must be positive");
+  if (settings.maxIterationsPerLevel < 1) throwUsage("subdivision: at least one iteration per level is needed");
+}
+
+/// The local/global iterations of one level (§5 steps 1-4), from the trivially refined
+/// base towards the targets; returns the final positions.
+Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, const Positions& targets,
+                         const PqSubdivisionSettings& settings, PqLevelInfo& info) {
+  const ShapeSpace space(refined);
+  GlobalStep global(backend, space, {}, settings.globalStep);
+  const double diagonal = boundingBoxDiagonal(targets);
+  Positions previous = targets;
+  Positions target = targets;
+  FaceMaps maps;
+  PolygonMesh current{targets, refined.faces};
+  for (int iteration = 0; iteration < settings.maxIterationsPerLevel; ++iteration) {
+    const LocalStepResult local = fitFaceMaps(backend, space, target);
+    const GlobalStepInfo step = global.solve(local.fits.maps, Positions(), maps);
+    current.vertices = space.positions(maps.maps);
+
+    PqIteration record;
+    record.epsilon = step.epsilon;
+    record.constraintResidual = step.constraintResidual;
+    record.admmIterations = step.admmIterations;
+    record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
+    record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;
+    info.iterations.push_back(record);
+    if (record.maxPlanarity <= settings.planarityTolerance && record.maxChange <= settings.changeTolerance) {
+      info.converged = true;
+      break;
+    }
+    previous = current.vertices;
+    target = current.vertices;
+  }
+  return current.vertices;
+}
+
+}  // namespace
+
+const char* toString(PqSubdivisionStatus status) {
+  switch (status) {
+    case PqSubdivisionStatus::Converged: return "converged";
+    case PqSubdivisionStatus::IterationLimit: return "iteration_limit";
+    case PqSubdivisionStatus::LinearOnly: return "linear_only";
+  }
+  return "unknown";
+}
+
+PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
+                                         const PqSubdivisionSettings& settings) {
+  checkSettings(settings);
+  const auto start = Clock::now();
+  PqSubdivisionResult result{SubdivisionHierarchy(base.faces, base.vertexCount(), settings.levels), {base.vertices}, {}};
+  PqSubdivisionInfo& info = result.info;
+  info.status = settings.planarize ? PqSubdivisionStatus::Converged : PqSubdivisionStatus::LinearOnly;
+
+  for (int level = 1; level <= settings.levels; ++level) {
+    const auto levelStart = Clock::now();
+    const QuadRefinement& refinement = result.hierarchy.refinement(level);
+    const FaceList& coarseFaces = result.hierarchy.faces(level - 1);
+    const Positions& coarse = result.positions.back();
+    const Positions linear = linearSubdivision(settings.scheme, coarseFaces, coarse, refinement);
+
+    PqLevelInfo levelInfo;
+    levelInfo.level = level;
+    levelInfo.vertices = refinement.fineVertexCount();
+    levelInfo.faces = refinement.fineFaces.size();
+    levelInfo.linearMaxPlanarity =
+        planarityOf(backend, PolygonMesh{linear, refinement.fineFaces}, settings.planarityTolerance).max;
+
+    Positions fine = linear;
+    if (settings.planarize) {
+      const PolygonMesh refined{trivialRefinementPositions(refinement, coarseFaces, coarse), refinement.fineFaces};
+      fine = planarizeLevel(backend, refined, linear, settings, levelInfo);
+      if (!levelInfo.converged) info.status = PqSubdivisionStatus::IterationLimit;
+    }
+    const double diagonal = boundingBoxDiagonal(linear);
+    levelInfo.distanceToLinear = diagonal > 0.0 ? maxRowDistance(fine, linear) / diagonal : 0.0;
+    levelInfo.planarity = planarityOf(backend, PolygonMesh{fine, refinement.fineFaces}, settings.planarityTolerance);
+    levelInfo.seconds = secondsSince(levelStart);
+    info.totalIterations += static_cast<int>(levelInfo.iterations.size());
+    info.levels.push_back(std::move(levelInfo));
+    result.positions.push_back(std::move(fine));
+  }
+  info.seconds = secondsSince(start);
+  return result;
+}
+
+}  // namespace plano::projective

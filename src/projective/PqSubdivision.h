@@ -1,0 +1,95 @@
+#pragma once
+// Planar-quad subdivision (projective-maps paper, §5). Each level: refine trivially
+// (QuadRefinement.h; the refined mesh is the base of a fresh projective shape space),
+// take target positions q from a linear scheme (SubdivisionSchemes.h), then iterate
+//   1. local step: the projective map of every face from the base to the targets, both
+//      projected onto their best-fitting planes first (fitFaceMaps);
+//   2. global step: project the maps onto the compatible shape space with the ε schedule
+//      (GlobalStep), giving new positions;
+//   3. reuse the new positions as targets;
+// until the max planarity is under the bound and the max vertex change between two
+// iterations (the first compared with the linear targets) is under `changeTolerance`
+// times the bounding-box diagonal. The result of a level is the coarse mesh of the next.
+#include <vector>
+
+#include "compute/Backend.h"
+#include "mesh/Planarity.h"
+#include "mesh/PolygonMesh.h"
+#include "projective/GlobalStep.h"
+#include "projective/MultiresHierarchy.h"
+#include "projective/SubdivisionSchemes.h"
+
+namespace plano::projective {
+
+struct PqSubdivisionSettings {
+  SubdivisionScheme scheme = SubdivisionScheme::CatmullClark;
+  int levels = 1;
+  /// Bound on the max face planarity (percent); the paper uses 0.1 % (Catmull-Clark) and
+  /// relaxes it to 0.5 % for the interpolating four-point scheme.
+  double planarityTolerance = 0.1;
+  /// Bound on the max vertex change between iterations, relative to the bbox diagonal.
+  double changeTolerance = 1e-3;
+  int maxIterationsPerLevel = 20;
+  /// false: only the linear scheme (no local/global iterations), for comparisons.
+  bool planarize = true;
+  GlobalStepSettings globalStep;
+};
+
+enum class PqSubdivisionStatus {
+  Converged,       ///< Every level met both stopping bounds.
+  IterationLimit,  ///< Some level stopped at maxIterationsPerLevel (result still usable).
+  LinearOnly,      ///< planarize = false: the linear scheme's positions.
+};
+
+const char* toString(PqSubdivisionStatus status);
+
+/// One local/global iteration.
+struct PqIteration {
+  double epsilon = 0.0;          ///< ε of the accepted global step.
+  double maxPlanarity = 0.0;     ///< Percent, after the global step.
+  double maxChange = 0.0;        ///< Max vertex change relative to the diagonal.
+  double constraintResidual = 0.0;  ///< max |C_s A - d| of the global step.
+  int admmIterations = 0;
+};
+
+struct PqLevelInfo {
+  int level = 0;
+  Index vertices = 0;
+  Index faces = 0;
+  bool converged = false;
+  std::vector<PqIteration> iterations;
+  double linearMaxPlanarity = 0.0;  ///< Max planarity (percent) of the linear scheme's targets.
+  /// Max distance between a vertex and its linear-scheme target of this level, relative
+  /// to the bounding-box diagonal.
+  double distanceToLinear = 0.0;
+  PlanarityStats planarity;
+  double seconds = 0.0;
+};
+
+struct PqSubdivisionInfo {
+  PqSubdivisionStatus status = PqSubdivisionStatus::Converged;
+  std::vector<PqLevelInfo> levels;  ///< Levels 1..n.
+  int totalIterations = 0;          ///< Local/global iterations summed over the levels.
+  double seconds = 0.0;
+};
+
+struct PqSubdivisionResult {
+  SubdivisionHierarchy hierarchy;
+  std::vector<Positions> positions;  ///< Per level 0..n (#V_l x 3); level 0 is the input.
+  PqSubdivisionInfo info;
+
+  /// The finest mesh.
+  PolygonMesh finestMesh() const { return {positions.back(), hierarchy.faces(hierarchy.finestLevel())}; }
+};
+
+/// Subdivide `base` settings.levels times.
+///   backend  in: runs the local fits, planarity and the global step's linear solves.
+///   base     in: polygon mesh (any face degrees, oriented 2-manifold, with or without
+///            boundary); ideally planar-faced, since level 1 starts from its trivial
+///            refinement.
+/// Throws Error(Usage) for levels < 0 or non-positive tolerances, Error(BadInput) for a
+/// mesh the refinement rejects, Error(Numerical) when a global step fails.
+PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
+                                         const PqSubdivisionSettings& settings = {});
+
+}  // namespace plano::projective

@@ -1,0 +1,126 @@
+// Device linear algebra against Eigen: SpMV, dot, axpby, row scaling and box projection
+// to 1e-12 relative.
+#include "compute/vulkan/VulkanLinearAlgebra.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "compute/MeshMatrices.h"
+#include "compute/VulkanFixture.h"
+#include "core/Error.h"
+
+namespace plano::test {
+namespace {
+
+Eigen::MatrixXd randomBlock(Index n, Index m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return Eigen::MatrixXd::NullaryExpr(n, m, [&](Eigen::Index, Eigen::Index) { return u(rng); });
+}
+
+double relativeError(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected) {
+  return (actual - expected).norm() / expected.norm();
+}
+
+class VulkanLinearAlgebra : public VulkanTest {
+ protected:
+  static void TearDownTestSuite() { algebra_.reset(); }
+  vk::LinearAlgebra& algebra() {
+    if (!algebra_) algebra_ = std::make_unique<vk::LinearAlgebra>(context());
+    return *algebra_;
+  }
+  vk::DeviceVectors vectors(const Eigen::MatrixXd& values, const char* what = "test vectors") {
+    vk::DeviceVectors v(context(), static_cast<std::uint32_t>(values.rows()),
+                        static_cast<std::uint32_t>(values.cols()), what);
+    v.upload(values);
+    return v;
+  }
+  static inline std::unique_ptr<vk::LinearAlgebra> algebra_;
+};
+
+TEST_F(VulkanLinearAlgebra, SpmvMatchesEigenOnRectangularMatrixAndSeveralColumns) {
+  const compute::SparseMatrix A = randomSparse(3000, 2000, 7, 1);
+  const Eigen::MatrixXd X = randomBlock(2000, 3, 2);
+  vk::DeviceCsrMatrix deviceA(context(), A);
+  vk::DeviceVectors x = vectors(X);
+  vk::DeviceVectors y(context(), 3000, 3, "y");
+  vk::Sequence s(context());
+  s.begin();
+  algebra().spmv(s, deviceA, x, y);
+  s.end();
+  s.run();
+  Eigen::MatrixXd Y;
+  y.download(Y);
+  EXPECT_LT(relativeError(Y, A * X), 1e-12);
+}
+
+TEST_F(VulkanLinearAlgebra, DotProductsMatchEigenPerColumnForManySizes) {
+  for (Index n : {1, 63, 64, 1000, 100000}) {
+    const Eigen::MatrixXd X = randomBlock(n, 3, 3), Y = randomBlock(n, 3, 4);
+    vk::DeviceVectors x = vectors(X), y = vectors(Y);
+    vk::DeviceScalars scalars(context(), 2, 3, static_cast<std::uint32_t>(n));
+    vk::Sequence s(context());
+    s.begin();
+    algebra().dot(s, x, y, scalars, 1);
+    algebra().dot(s, x, x, scalars, 0);
+    s.end();
+    s.run();
+    const std::vector<double> values = scalars.read();
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      const double expected = X.col(c).dot(Y.col(c));
+      EXPECT_NEAR(scalars.at(values, 1, c), expected, 1e-12 * X.col(c).norm() * Y.col(c).norm()) << "n " << n;
+      EXPECT_NEAR(scalars.at(values, 0, c), X.col(c).squaredNorm(), 1e-12 * X.col(c).squaredNorm()) << "n " << n;
+    }
+  }
+}
+
+TEST_F(VulkanLinearAlgebra, AxpbyScaleRowsAndCopyMatchEigen) {
+  const Eigen::MatrixXd X = randomBlock(5000, 2, 5), Y = randomBlock(5000, 2, 6);
+  const Eigen::VectorXd d = randomBlock(5000, 1, 7).col(0);
+  vk::DeviceVectors x = vectors(X), y = vectors(Y), z(context(), 5000, 2, "z"), w(context(), 5000, 2, "w");
+  vk::Array<double> diagonal(context(), 5000, vk::MemoryClass::Device, "d");
+  diagonal.upload({d.data(), 5000});
+  vk::Sequence s(context());
+  s.begin();
+  algebra().axpby(s, 2.5, x, -0.5, y);
+  algebra().scaleRows(s, diagonal, y, z);
+  algebra().copy(s, z, w);
+  s.end();
+  s.run();
+  Eigen::MatrixXd Yd, Zd, Wd;
+  y.download(Yd);
+  z.download(Zd);
+  w.download(Wd);
+  const Eigen::MatrixXd expectedY = 2.5 * X - 0.5 * Y;
+  EXPECT_LT(relativeError(Yd, expectedY), 1e-12);
+  EXPECT_LT(relativeError(Zd, d.asDiagonal() * expectedY), 1e-12);
+  EXPECT_EQ(Wd, Zd);
+}
+
+TEST_F(VulkanLinearAlgebra, ClampProjectsOntoTheBox) {
+  const Eigen::MatrixXd X = 2.0 * randomBlock(4000, 3, 8);
+  const Eigen::MatrixXd L = Eigen::MatrixXd::Constant(4000, 3, -1.0) + 0.1 * randomBlock(4000, 3, 9);
+  const Eigen::MatrixXd U = Eigen::MatrixXd::Constant(4000, 3, 1.0) + 0.1 * randomBlock(4000, 3, 10);
+  vk::DeviceVectors x = vectors(X), l = vectors(L), u = vectors(U), y(context(), 4000, 3, "y");
+  vk::Sequence s(context());
+  s.begin();
+  algebra().clamp(s, x, l, u, y);
+  s.end();
+  s.run();
+  Eigen::MatrixXd Y;
+  y.download(Y);
+  EXPECT_EQ(Y, X.cwiseMax(L).cwiseMin(U));
+  EXPECT_GT((Y - X).cwiseAbs().maxCoeff(), 0.5);  // the box was active somewhere
+}
+
+TEST_F(VulkanLinearAlgebra, MismatchedShapesAreUsageErrors) {
+  vk::DeviceVectors a(context(), 10, 3, "a"), b(context(), 11, 3, "b");
+  vk::Sequence s(context());
+  s.begin();
+  EXPECT_THROW(algebra().axpby(s, 1.0, a, 1.0, b), Error);
+  s.end();
+}
+
+}  // namespace
+}  // namespace plano::test

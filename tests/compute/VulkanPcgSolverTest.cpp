@@ -1,0 +1,106 @@
+// The device PCG solver against CHOLMOD on Laplacian-like SPD systems from meshes.
+#include "compute/vulkan/VulkanPcgSolver.h"
+
+#include <gtest/gtest.h>
+
+#include "compute/MeshMatrices.h"
+#include "compute/VulkanFixture.h"
+#include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
+#include "mesh/Generators.h"
+
+namespace plano::test {
+namespace {
+
+class VulkanPcgSolver : public VulkanTest {};
+
+Eigen::MatrixXd rightHandSides(const PolygonMesh& mesh) {
+  // Like a global step: the coordinates themselves plus a smooth bump.
+  Eigen::MatrixXd B = mesh.vertices;
+  B.col(2) += mesh.vertices.col(0).array().sin().matrix();
+  return B;
+}
+
+TEST_F(VulkanPcgSolver, MatchesCholmodToTheRequestedTolerance) {
+  const PolygonMesh mesh = generate::translationalSurface(40, 40);
+  const compute::SparseMatrix A = laplacianLikeSpd(mesh, 0.01);
+  const Eigen::MatrixXd B = rightHandSides(mesh);
+  compute::LinearSolverSettings settings;
+  settings.relativeTolerance = 1e-10;
+  auto pcg = backend().createSpdSolver(A, settings);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(B.rows(), B.cols());
+  const compute::LinearSolveInfo info = pcg->solve(B, X);
+  EXPECT_TRUE(info.converged);
+  EXPECT_GT(info.iterations, 0);
+  EXPECT_LE(info.relativeResidual, 1e-10 * 1.5);  // recursive vs true residual
+  EXPECT_LE((A * X - B).norm() / B.norm(), 1.5e-10);
+
+  auto cholmod = compute::CpuBackend().createSpdSolver(A, settings);
+  Eigen::MatrixXd reference;
+  cholmod->solve(B, reference);
+  // Error bound from the residual: ||x - x*|| <= ||A^-1|| ||r|| <= ||r|| / lambda_min.
+  EXPECT_LT((X - reference).norm() / reference.norm(), 1e-6);
+}
+
+TEST_F(VulkanPcgSolver, WarmStartFromTheSolutionNeedsNoIterations) {
+  const PolygonMesh mesh = generate::hexagonalDome(6);
+  const compute::SparseMatrix A = laplacianLikeSpd(mesh, 0.1);
+  const Eigen::MatrixXd B = rightHandSides(mesh);
+  compute::LinearSolverSettings settings;
+  settings.relativeTolerance = 1e-8;
+  auto pcg = backend().createSpdSolver(A, settings);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(B.rows(), 3);
+  const compute::LinearSolveInfo cold = pcg->solve(B, X);
+  ASSERT_TRUE(cold.converged);
+  const compute::LinearSolveInfo warm = pcg->solve(B, X);
+  EXPECT_TRUE(warm.converged);
+  EXPECT_EQ(warm.iterations, 0);
+  EXPECT_LT(warm.relativeResidual, 1e-8);
+}
+
+TEST_F(VulkanPcgSolver, LooserToleranceTakesFewerIterations) {
+  const PolygonMesh mesh = generate::surfaceOfRevolution(40, 20);
+  const compute::SparseMatrix A = laplacianLikeSpd(mesh, 0.01);
+  const Eigen::MatrixXd B = rightHandSides(mesh);
+  compute::LinearSolverSettings loose, tight;
+  loose.relativeTolerance = 1e-4;
+  tight.relativeTolerance = 1e-11;
+  Eigen::MatrixXd X1 = Eigen::MatrixXd::Zero(B.rows(), 3), X2 = X1;
+  const auto a = backend().createSpdSolver(A, loose)->solve(B, X1);
+  const auto b = backend().createSpdSolver(A, tight)->solve(B, X2);
+  EXPECT_TRUE(a.converged && b.converged);
+  EXPECT_LT(a.iterations, b.iterations);
+  EXPECT_LE(a.relativeResidual, 1.5e-4);
+  EXPECT_LE(b.relativeResidual, 1.5e-11);
+}
+
+TEST_F(VulkanPcgSolver, IterationCapIsReportedAsNotConverged) {
+  const PolygonMesh mesh = generate::translationalSurface(30, 30);
+  const compute::SparseMatrix A = laplacianLikeSpd(mesh, 1e-4);
+  compute::LinearSolverSettings settings;
+  settings.relativeTolerance = 1e-12;
+  settings.maxIterations = 16;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(A.rows(), 3);
+  const auto info = backend().createSpdSolver(A, settings)->solve(rightHandSides(mesh), X);
+  EXPECT_FALSE(info.converged);
+  EXPECT_EQ(info.iterations, 16);
+  EXPECT_GT(info.relativeResidual, 1e-12);
+}
+
+TEST_F(VulkanPcgSolver, NonPositiveDiagonalIsANumericalErrorNamingTheRow) {
+  compute::SparseMatrix A(3, 3);
+  A.insert(0, 0) = 1.0;
+  A.insert(1, 1) = -2.0;
+  A.insert(2, 2) = 1.0;
+  A.makeCompressed();
+  try {
+    backend().createSpdSolver(A, {});
+    FAIL() << "expected Error(Numerical)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("row 1"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace plano::test

@@ -1,0 +1,63 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "mesh/Generators.h"
+#include "mesh/MeshIO.h"
+#include "mesh/Planarity.h"
+#include "support/TestMeshes.h"
+
+namespace plano {
+namespace {
+
+TEST(SubdivisionCommand, WritesThePlanarQuadMeshAndAReportPerLevel) {
+  test::TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const auto result = test::runTool("-q subdivide " + (dir / "cube.obj").string() + " -o " + (dir / "fine.obj").string() +
+                                    " --levels 2 --report " + (dir / "report.json").string());
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const PolygonMesh fine = readMesh(dir / "fine.obj");
+  EXPECT_EQ(fine.faceCount(), 96);
+  EXPECT_LT(planarityStats(fine).max, 0.1);
+  std::ifstream in(dir / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["command"], "subdivide");
+  EXPECT_EQ(report["scheme"], "catmull-clark");
+  EXPECT_EQ(report["status"], "converged");
+  EXPECT_EQ(report["faces"], 96);
+  ASSERT_EQ(report["levels"].size(), 2u);
+  int iterations = 0;
+  for (const auto& level : report["levels"]) {
+    EXPECT_EQ(level["epsilons"].size(), level["iterations"].get<std::size_t>());
+    EXPECT_LT(level["planarity"]["max"].get<double>(), 0.1);
+    iterations += level["iterations"].get<int>();
+  }
+  EXPECT_EQ(report["iterations"], iterations);
+}
+
+TEST(SubdivisionCommand, InPlaceLinearFourPointKeepsTheCoarseVertices) {
+  test::TempDir dir;
+  const PolygonMesh cube = generate::cube();
+  writeMesh(dir / "cube.off", cube);
+  const auto result = test::runTool("-q subdivide " + (dir / "cube.off").string() + " --in-place --linear --scheme four-point");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const PolygonMesh fine = readMesh(dir / "cube.off");
+  EXPECT_EQ(fine.faceCount(), 24);
+  EXPECT_LT(test::maxAbsDifference(fine.vertices.topRows(8), cube.vertices), 1e-15);
+}
+
+TEST(SubdivisionCommand, ReportsUsageAndInputErrorsWithTheirExitCodes) {
+  test::TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const std::string mesh = (dir / "cube.obj").string();
+  EXPECT_EQ(test::runTool("subdivide " + mesh).exitCode, 2);  // no output
+  EXPECT_EQ(test::runTool("subdivide " + mesh + " -o x.obj --scheme loop").exitCode, 2);
+  EXPECT_EQ(test::runTool("subdivide " + mesh + " -o x.obj --in-place").exitCode, 2);
+  const auto missing = test::runTool("subdivide " + (dir / "missing.obj").string() + " -o " + (dir / "out.obj").string());
+  EXPECT_EQ(missing.exitCode, 3) << missing.err;
+  EXPECT_NE(missing.err.find("missing.obj"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace plano
