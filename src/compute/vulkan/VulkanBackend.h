@@ -33,6 +33,8 @@ class VulkanBackend final : public Backend {
                          ProjectiveFits& out) override;
   void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                         std::span<Eigen::Vector3d> singularValues) override;
+  /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
+  /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
 
   /// The device context (device properties, validation messages).
