@@ -5,8 +5,8 @@
 // the signed distance between the diagonals ac and bd over their mean length L_j: exactly
 // the papers' planarity (mesh/Planarity.h) with a sign. Each iteration linearizes c at x^k
 // (exact gradient) and takes the step
-//   min_dx |J dx + c|^2  subject to the linearized constraints J dx + c = 0 (softened by a
-//   tiny nu), aiming at dx0 = w / (w + mu) (x^input - x^k)  (w closeness, mu damping),
+//   min_dx |dx - dx0|^2  subject to  J dx + c = 0  (softened by a tiny nu),
+//   dx0 = w / (w + mu) (x^input - x^k)  (w closeness, mu damping: a pull back to the input),
 // over the free vertices, whose solution is
 //   dx = dx0 - J^T y,   (J J^T + nu I) y = c + J dx0:
 // a scalar SPD system with one unknown per constraint row and the sparsity of "rows that
