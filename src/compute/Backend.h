@@ -50,6 +50,14 @@ class SpdSolver {
   /// use it; direct solvers ignore it) and the solution on exit.
   virtual LinearSolveInfo solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
   virtual Eigen::Index size() const = 0;
+  /// Replace A by a matrix with the same sparsity pattern (precondition) and factor or
+  /// upload it again, reusing what depends on the pattern only (a direct solver's ordering
+  /// and symbolic analysis). Returns false when this solver cannot; the caller then creates
+  /// a new one. For algorithms whose matrix changes every iteration (Gauss-Newton steps).
+  virtual bool refactor(const SparseMatrix& A) {
+    (void)A;
+    return false;
+  }
 };
 
 class Backend {

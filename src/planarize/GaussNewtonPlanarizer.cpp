@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "core/Error.h"
 #include "mesh/Planarity.h"
@@ -29,6 +30,7 @@ struct GaussNewtonWorkspace {
   Eigen::VectorXd residual;                             ///< Per row: signed c_j.
   Eigen::MatrixXd rhs, dual;                            ///< #rows x 1.
   Positions step;                                       ///< #V x 3.
+  std::unique_ptr<compute::SpdSolver> solver;           ///< Refactored each iteration.
 };
 
 namespace {
@@ -112,11 +114,16 @@ double linearize(const Problem& problem, const Positions& Y, GaussNewtonWorkspac
     const double value = e.dot(m) * factor;
     ws.residual[static_cast<Index>(j)] = value;
     merit += value * value;
-    // Gradient of the triple product V = e.(d1 x d2); translations leave it unchanged.
-    J.row(0) = -(m + d2.cross(e)) * factor;
-    J.row(1) = (m - e.cross(d1)) * factor;
-    J.row(2) = d2.cross(e) * factor;
-    J.row(3) = e.cross(d1) * factor;
+    // Exact gradient of c = V / (|m| L): the triple product V = e.(d1 x d2) over its
+    // normalization. Dropping the normalization's gradient (exact only at c = 0) left a
+    // few near-degenerate faces of subdivided meshes stuck above 0.1 %.
+    const Eigen::Vector3d u = m / mNorm;
+    const Eigen::Vector3d gd1 = d2.cross(u) / mNorm + 0.5 * d1 / (d1.norm() * meanDiagonal);
+    const Eigen::Vector3d gd2 = u.cross(d1) / mNorm + 0.5 * d2 / (d2.norm() * meanDiagonal);
+    J.row(0) = (-(m + d2.cross(e)) * factor + value * gd1).transpose();
+    J.row(1) = ((m - e.cross(d1)) * factor + value * gd2).transpose();
+    J.row(2) = (d2.cross(e) * factor - value * gd1).transpose();
+    J.row(3) = (e.cross(d1) * factor - value * gd2).transpose();
     for (int corner = 0; corner < 4; ++corner)
       if (problem.freeIndex[r[corner]] < 0) J.row(corner).setZero();
   }
@@ -150,11 +157,17 @@ compute::LinearSolveInfo computeStep(const Problem& problem, const Positions& Y,
       }
     }
   }
-  // J J^T changes with every linearization: a fresh solver per step (a direct backend
-  // factors it; an iterative one starts from zero).
+  // J J^T changes with every linearization but keeps its pattern: refactor, reusing the
+  // ordering and symbolic analysis where the backend can (measured 20-35 % faster per
+  // iteration on the CPU than a fresh solver). Reusing an old factor as a preconditioner
+  // of conjugate gradients instead was tried and failed: with the tiny softening the
+  // matrix's small eigenvalues move too much between iterations (relative residual 0.5
+  // after 8 steps on spot_quad).
   ws.dual.setZero(ws.system.rows(), 1);
-  const auto solver = backend.createSpdSolver(ws.system, compute::LinearSolverSettings{});
-  const compute::LinearSolveInfo info = solver->solve(ws.rhs, ws.dual);
+  if (!ws.solver || !ws.solver->refactor(ws.system)) {
+    ws.solver = backend.createSpdSolver(ws.system, compute::LinearSolverSettings{});
+  }
+  const compute::LinearSolveInfo info = ws.solver->solve(ws.rhs, ws.dual);
   for (Index v = 0; v < vertexCount; ++v) {
     for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p) {
       const auto [row, corner] = ws.incidences[p];
@@ -162,6 +175,24 @@ compute::LinearSolveInfo computeStep(const Problem& problem, const Positions& Y,
     }
   }
   return info;
+}
+
+/// Chord (simplified Newton) step of the projection with the current factor and Jacobian J_k
+/// on the residuals `residual` of a later point: dx = -J_k^T (J_k J_k^T + nu I)^-1 c.
+/// One back-substitution, no factorization.
+void correctorStep(const Problem& problem, const std::vector<Eigen::Matrix<double, 4, 3>>& jacobian,
+                   const Eigen::VectorXd& residual, GaussNewtonWorkspace& ws) {
+  const Index vertexCount = static_cast<Index>(problem.freeIndex.size());
+  ws.rhs = residual;
+  ws.dual.setZero(ws.system.rows(), 1);
+  ws.solver->solve(ws.rhs, ws.dual);
+  ws.step.setZero(vertexCount, 3);
+  for (Index v = 0; v < vertexCount; ++v) {
+    for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p) {
+      const auto [row, corner] = ws.incidences[p];
+      ws.step.row(v) -= ws.dual(row, 0) * jacobian[row].row(corner);
+    }
+  }
 }
 
 }  // namespace
@@ -205,7 +236,8 @@ Info GaussNewtonPlanarizer::solve(Positions& vertices) {
   double softening = minimumSoftening;
   bool pullBackActive = true;
   int rejectedInARow = 0;
-  Positions candidate;
+  Positions candidate, corrected;
+  std::vector<Eigen::Matrix<double, 4, 3>> jacobianAtStep;
   while (!converged && info.iterations < settings_.maxIterations) {
     const compute::LinearSolveInfo solve =
         detail::computeStep(problem, Y, pullBackActive ? pullBack : 0.0, softening, *backend_, ws);
@@ -214,6 +246,7 @@ Info GaussNewtonPlanarizer::solve(Positions& vertices) {
     if (!ws.step.allFinite()) {
       throwNumerical("planarize: Gauss-Newton step became non-finite at iteration " + std::to_string(info.iterations));
     }
+    if (settings_.correctorSteps > 0) jacobianAtStep = ws.jacobian;
     // Backtracking on the merit sum c_j^2 (a step that lands within the tolerance is
     // always taken). The linearization at the accepted candidate is the next iteration's.
     bool accepted = false;
@@ -225,6 +258,23 @@ Info GaussNewtonPlanarizer::solve(Positions& vertices) {
         accepted = true;
         merit = candidateMerit;
       }
+    }
+    if (accepted && settings_.correctorSteps > 0 && !monitor.wouldConverge(candidate)) {
+      // Corrector steps with this iteration's factor: the nonlinear part of the constraints
+      // left by the step, removed at the cost of back-substitutions.
+      Eigen::VectorXd residualNow = ws.residual;
+      for (int c = 0; c < settings_.correctorSteps; ++c) {
+        detail::correctorStep(problem, jacobianAtStep, residualNow, ws);
+        corrected = candidate + ws.step;
+        const double correctedMerit = detail::linearize(problem, corrected, ws);
+        if (!(correctedMerit < merit)) break;
+        ++info.correctorSteps;
+        candidate.swap(corrected);
+        merit = correctedMerit;
+        residualNow = ws.residual;
+      }
+      // Leave the linearization of the accepted candidate in the workspace.
+      detail::linearize(problem, candidate, ws);
     }
     if (accepted) {
       const double change = stepLength * ws.step.cwiseAbs().maxCoeff();

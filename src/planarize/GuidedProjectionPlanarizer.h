@@ -16,10 +16,10 @@
 // that raises the penalty energy (corner-to-best-plane distances + closeness) is
 // rejected and retried with ten times the damping.
 //
-// Kept as a comparison for GaussNewtonPlanarizer: it converges in as few iterations, but
-// its reduced system has 3 #free unknowns with 3x3 blocks, so a sparse factorization per
-// iteration costs about 27 times that of a scalar system on the same mesh
-// (bench/PlanarizeBench.cpp).
+// Kept as a comparison for GaussNewtonPlanarizer (bench/PlanarizeBench.cpp): its closeness
+// is a penalty, so its fixed point stays slightly non-planar and the last tenth of a
+// percent takes many iterations; and its reduced system has 3 #free unknowns with 3x3
+// blocks, about 27 times the factorization flops of a scalar system on the same mesh.
 #include <memory>
 
 #include "compute/Backend.h"

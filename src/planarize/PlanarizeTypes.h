@@ -47,6 +47,9 @@ struct Settings {
   /// Weight mu of |X - X_previous|^2. Guided: Levenberg-Marquardt damping (least value; it
   /// grows after a rejected step). Gauss-Newton: sets the pull back to the input, above.
   double damping = 1e-4;
+  /// Gauss-Newton only: at most this many chord steps per iteration, each reusing the
+  /// iteration's factorization (one back-substitution) on the updated residuals.
+  int correctorSteps = 3;
 };
 
 enum class Status {
@@ -70,6 +73,8 @@ struct Info {
   /// Steps the safeguard rejected: Anderson extrapolations that raised the energy (the
   /// plain step was taken instead), Gauss-Newton and guided steps retried from the same iterate.
   int rejectedSteps = 0;
+  /// Gauss-Newton only: chord steps taken (back-substitutions with an iteration's factor).
+  int correctorSteps = 0;
   double seconds = 0.0;  ///< Wall time of precompute + solve.
 };
 

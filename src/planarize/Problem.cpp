@@ -41,6 +41,7 @@ Problem makeProblem(const FaceList& faces, const Positions& input, const Setting
   if (settings.maxIterations < 0) throwUsage("planarize: max iterations must be >= 0");
   if (settings.andersonDepth < 1) throwUsage("planarize: Anderson depth must be >= 1");
   if (!(settings.damping > 0.0)) throwUsage("planarize: damping must be > 0");
+  if (settings.correctorSteps < 0) throwUsage("planarize: corrector steps must be >= 0");
 
   const Index vertexCount = static_cast<Index>(input.rows());
   for (Index v = 0; v < vertexCount; ++v) {

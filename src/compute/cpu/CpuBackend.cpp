@@ -35,6 +35,16 @@ class CholmodSpdSolver final : public SpdSolver {
 
   Eigen::Index size() const override { return size_; }
 
+  bool refactor(const SparseMatrix& A) override {
+    if (A.rows() != size_ || A.cols() != size_) return false;
+    columnMajor_ = A;
+    factor_.factorize(columnMajor_);
+    if (factor_.info() != Eigen::Success) {
+      throwNumerical("SPD solver: Cholesky factorization failed (matrix not positive definite)");
+    }
+    return true;
+  }
+
  private:
   Eigen::Index size_;
   Eigen::SparseMatrix<double> columnMajor_;

@@ -46,6 +46,7 @@ nlohmann::json reportJson(const PlanarizeOptions& options, const planarize::Sett
   j["status"] = planarize::toString(info.status);
   j["iterations"] = info.iterations;
   j["rejected_steps"] = info.rejectedSteps;
+  j["corrector_steps"] = info.correctorSteps;
   j["closeness"] = settings.closeness;
   j["fixed_vertices"] = settings.fixed.size();
   j["planarity_per_iteration"] = {{"max", info.maxPlanarity}, {"mean", info.meanPlanarity}};
