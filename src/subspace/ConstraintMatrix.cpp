@@ -1,5 +1,6 @@
 #include "subspace/ConstraintMatrix.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/Error.h"
@@ -63,6 +64,7 @@ ConstraintMatrix buildConstraintMatrix(const PolygonMesh& Y, std::span<const Fac
     B.faceRowOffsets[f] = row;
     if (k == 3 && spaces[f] == FaceSpace::Affine) continue;  // Triangles are always affine images.
     const FaceFrame frame = fitFaceFrame(Y.vertices, face, f, settings.degeneracy);
+    B.maxNonPlanarity = std::max(B.maxNonPlanarity, frame.nonPlanarity);
     Eigen::MatrixXd block;
     if (B.separable) {
       block = affineFaceBlock(frame);

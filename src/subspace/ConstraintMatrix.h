@@ -30,6 +30,10 @@ struct ConstraintMatrix {
   std::vector<FaceSpace> assigned;        ///< The type asked for, per face.
   std::vector<FaceSpace> effective;       ///< The type built: a horizontal vertical face becomes parallel.
   Index vertexCount = 0;
+  /// Largest relative non-planarity (third over first singular value of the centred
+  /// corners) of a constrained source face: the noise level of B, since each block is
+  /// built from the face's best-fitting plane.
+  double maxNonPlanarity = 0.0;
 
   /// Number of rows of the full B (3x the stored rows when separable).
   Index equationCount() const;

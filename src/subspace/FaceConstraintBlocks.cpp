@@ -36,6 +36,7 @@ FaceFrame fitFaceFrame(const Positions& Y, std::span<const Index> face, Index f,
   Eigen::JacobiSVD<Eigen::MatrixX3d> svd(P, Eigen::ComputeThinV);
   const Eigen::Vector3d s = svd.singularValues();
   frame.flatness = s[0] > 0.0 ? s[1] / s[0] : 0.0;
+  frame.nonPlanarity = s[0] > 0.0 ? s[2] / s[0] : 0.0;
   if (!(frame.flatness > degeneracy)) {
     throwBadInput("face " + std::to_string(f) + " is degenerate (its corners are collinear or coincide)");
   }

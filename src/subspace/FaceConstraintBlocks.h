@@ -23,7 +23,8 @@ struct FaceFrame {
   Eigen::Vector3d normal;
   Eigen::Vector3d axis1, axis2;
   Eigen::MatrixX2d planar;
-  double flatness = 0.0;  ///< Second over first singular value of the centred corners.
+  double flatness = 0.0;      ///< Second over first singular value of the centred corners.
+  double nonPlanarity = 0.0;  ///< Third over first: 0 for an exactly planar face.
 };
 
 /// Fit the frame of face `face` (index `f` is used in messages). Throws Error(BadInput)

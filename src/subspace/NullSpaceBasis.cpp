@@ -1,6 +1,7 @@
 #include "subspace/NullSpaceBasis.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <Eigen/SPQRSupport>
 
 #include "core/Error.h"
@@ -14,8 +15,13 @@ Eigen::MatrixXd denseNullSpace(const compute::SparseMatrix& B, double tolerance,
     rank = 0;
     return Eigen::MatrixXd::Identity(n, n);
   }
-  const Eigen::MatrixXd dense(B);
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(dense, Eigen::ComputeFullV);
+  // A wide B is padded with zero rows (same singular values and V). One-sided Jacobi
+  // (after a QR preconditioner) gives null vectors accurate to rounding; the
+  // divide-and-conquer SVD was measured to lose digits on these clustered zero singular
+  // values and to return wrong vectors for the full V of a wide matrix.
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(std::max(B.rows(), n), n);
+  dense.topRows(B.rows()) = Eigen::MatrixXd(B);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(dense, Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   const double cut = tolerance * std::max(s.size() ? s[0] : 0.0, 1e-300);
   Eigen::Index r = 0;
@@ -54,17 +60,19 @@ SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettin
   BasisMethod method = settings.method;
   if (method == BasisMethod::Auto) method = unknowns <= settings.denseLimit ? BasisMethod::DenseSvd : BasisMethod::SparseQr;
   Index rank = 0;
-  Eigen::MatrixXd N = method == BasisMethod::DenseSvd ? denseNullSpace(B.matrix, settings.rankTolerance, rank)
-                                                      : sparseNullSpace(B.matrix, settings.rankTolerance, rank);
+  const double tolerance = std::max(settings.rankTolerance, settings.noiseFactor * B.maxNonPlanarity);
+  Eigen::MatrixXd N = method == BasisMethod::DenseSvd ? denseNullSpace(B.matrix, tolerance, rank)
+                                                      : sparseNullSpace(B.matrix, tolerance, rank);
   if (!N.allFinite()) throwNumerical("null-space basis of the constraint matrix is not finite");
   SubspaceBasis basis(std::move(N), B.separable);
   if (info) {
     info->method = method;
     info->unknowns = unknowns;
     info->rank = rank;
+    info->rankTolerance = tolerance;
     info->dimension = basis.dimension();
     const Eigen::MatrixXd& C = basis.columns();
-    info->residual = C.cols() ? (B.matrix * C).cwiseAbs().maxCoeff() : 0.0;
+    info->residual = C.cols() && B.matrix.rows() ? (B.matrix * C).cwiseAbs().maxCoeff() : 0.0;
     info->orthogonality =
         C.cols() ? (C.transpose() * C - Eigen::MatrixXd::Identity(C.cols(), C.cols())).cwiseAbs().maxCoeff() : 0.0;
   }

@@ -8,7 +8,7 @@ namespace plano::subspace {
 
 enum class BasisMethod {
   Auto,      ///< Dense SVD up to `denseLimit` unknowns, sparse QR above.
-  DenseSvd,  ///< SVD of the dense B: exact rank decisions, O(n^3); small meshes only.
+  DenseSvd,  ///< Jacobi SVD of the dense B: reliable rank decisions, O(n^3); small meshes only.
   SparseQr,  ///< SuiteSparseQR of B^T with column pivoting: rank-revealing in practice.
 };
 
@@ -18,14 +18,19 @@ struct BasisSettings {
   /// rankTolerance * (largest one) counts as zero. B has orthonormal rows per face, so
   /// its scale is 1 and this is also an absolute tolerance.
   double rankTolerance = 1e-9;
+  /// Faces of real meshes are planar only up to their file's precision (single-precision
+  /// OBJ: ~1e-7), which perturbs B by as much: the tolerance used is
+  /// max(rankTolerance, noiseFactor * B.maxNonPlanarity). 0 disables the adaptation.
+  double noiseFactor = 10.0;
   /// Unknowns (#V when separable, else 3 #V) up to which Auto uses the dense SVD.
-  Index denseLimit = 600;
+  Index denseLimit = 400;
 };
 
 struct BasisInfo {
   BasisMethod method = BasisMethod::Auto;  ///< The method that ran.
   Index unknowns = 0;                      ///< Columns of the stored B.
   Index rank = 0;                          ///< Numerical rank of the stored B.
+  double rankTolerance = 0.0;              ///< The relative tolerance used (after noise adaptation).
   Index dimension = 0;                     ///< dim null(B) of the full space.
   double residual = 0.0;                   ///< max |B N| entry: how exactly the basis lies in null(B).
   double orthogonality = 0.0;              ///< max |N^T N - I| entry.

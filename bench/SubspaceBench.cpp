@@ -1,0 +1,128 @@
+// Linear spaces of polyhedral meshes (linear-spaces paper, §4 "Implementation details":
+// "less than a second for meshes with approximately a thousand faces"): building B, its
+// null-space basis, K = 10 eigenshapes and one subspace ASAP iteration, on translational
+// surfaces of ~1k, ~10k and ~100k planar quads. Each stage is timed on its own: the
+// inputs of a stage are prepared outside the timed loop.
+//
+// Sizes left out, and why: the basis is dense (3#V x d), so 100k faces is run for the
+// separable affine space only; eigenshapes and deformation need N^T L N (#V d^2), which
+// is run up to 10k faces.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "compute/cpu/CpuBackend.h"
+#include "mesh/Generators.h"
+#include "subspace/Eigenshapes.h"
+#include "subspace/LinearSpace.h"
+#include "subspace/MeshLaplacian.h"
+#include "subspace/SubspaceDeformation.h"
+
+namespace {
+
+using namespace plano;
+using namespace plano::subspace;
+
+PolygonMesh gridOfFaces(std::int64_t faces) {
+  const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(faces))));
+  return generate::translationalSurface(side, side);
+}
+
+void BM_ConstraintMatrix(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const auto spaces = uniformAssignment(kind, mesh.faceCount());
+  for (auto _ : state) {
+    ConstraintMatrix B = buildConstraintMatrix(mesh, spaces);
+    benchmark::DoNotOptimize(B.matrix.nonZeros());
+  }
+  state.counters["faces"] = mesh.faceCount();
+}
+
+void BM_NullSpaceBasis(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const ConstraintMatrix B = buildConstraintMatrix(mesh, uniformAssignment(kind, mesh.faceCount()));
+  Index dimension = 0;
+  for (auto _ : state) {
+    const SubspaceBasis N = computeNullSpaceBasis(B);
+    dimension = N.dimension();
+    benchmark::DoNotOptimize(N.columns().data());
+  }
+  state.counters["faces"] = mesh.faceCount();
+  state.counters["dimension"] = dimension;
+}
+
+void BM_Eigenshapes(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(kind, mesh.faceCount()));
+  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
+  EigenshapeSettings settings;
+  settings.count = 10;
+  for (auto _ : state) {
+    const Eigenshapes shapes = computeEigenshapes(space.N, L, settings);
+    benchmark::DoNotOptimize(shapes.frequencies.data());
+  }
+  state.counters["faces"] = mesh.faceCount();
+  state.counters["dimension"] = space.N.dimension();
+}
+
+/// One local/global iteration, after the precomputation (which is reported separately
+/// as BM_DeformationPrecompute).
+void BM_DeformationIteration(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(kind, mesh.faceCount()));
+  const Index side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
+  PositionalConstraints constraints;
+  for (Index i = 0; i <= side; ++i) constraints.fixed.push_back(i);  // One boundary row.
+  const Index centre = (side / 2) * (side + 1) + side / 2;
+  constraints.handles.push_back({centre, mesh.vertices.row(centre).transpose() + Eigen::Vector3d(0, 0, 0.1)});
+  compute::CpuBackend backend;
+  SubspaceDeformationSettings settings;
+  settings.maxIterations = 1;
+  SubspaceDeformer deformer(space, constraints, backend, settings);
+  Positions X = mesh.vertices;
+  for (auto _ : state) {
+    deformer.solve(X);
+    benchmark::DoNotOptimize(X.data());
+  }
+  state.counters["faces"] = mesh.faceCount();
+  state.counters["dimension"] = space.N.dimension();
+}
+
+void BM_DeformationPrecompute(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(kind, mesh.faceCount()));
+  PositionalConstraints constraints;
+  constraints.fixed = {0, 1, 2};
+  compute::CpuBackend backend;
+  for (auto _ : state) {
+    SubspaceDeformer deformer(space, constraints, backend);
+    benchmark::DoNotOptimize(deformer.freeDimension());
+  }
+  state.counters["faces"] = mesh.faceCount();
+}
+
+BENCHMARK_CAPTURE(BM_ConstraintMatrix, affine, SpaceKind::Affine)
+    ->Arg(1024)->Arg(10000)->Arg(100489)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ConstraintMatrix, parallel, SpaceKind::Parallel)
+    ->Arg(1024)->Arg(10000)->Arg(100489)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ConstraintMatrix, vertical, SpaceKind::Vertical)
+    ->Arg(1024)->Arg(10000)->Arg(100489)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_CAPTURE(BM_NullSpaceBasis, affine, SpaceKind::Affine)
+    ->Arg(1024)->Arg(10000)->Arg(100489)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_NullSpaceBasis, parallel, SpaceKind::Parallel)
+    ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_NullSpaceBasis, vertical, SpaceKind::Vertical)
+    ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+BENCHMARK_CAPTURE(BM_Eigenshapes, affine, SpaceKind::Affine)->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Eigenshapes, parallel, SpaceKind::Parallel)->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_CAPTURE(BM_DeformationPrecompute, affine, SpaceKind::Affine)
+    ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_DeformationIteration, affine, SpaceKind::Affine)
+    ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeformationIteration, parallel, SpaceKind::Parallel)
+    ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+}  // namespace

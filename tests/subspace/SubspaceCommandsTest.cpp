@@ -1,0 +1,136 @@
+// The subspace commands of the plano tool, end to end (subspace, explore, shapes, dual,
+// embed, and the subspace deformation request behind `plano deform --space`).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "mesh/Generators.h"
+#include "mesh/MeshIO.h"
+#include "mesh/Planarity.h"
+#include "support/TestMeshes.h"
+
+namespace plano::test {
+namespace {
+
+nlohmann::json readJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::string quoted(const std::filesystem::path& p) { return "\"" + p.string() + "\""; }
+
+TEST(SubspaceCommand, ReportsDimensionLowerBoundAndFaceTypes) {
+  TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const auto result = runTool("-q subspace " + quoted(dir / "cube.obj") + " --space parallel --report " +
+                              quoted(dir / "r.json"));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto j = readJson(dir / "r.json");
+  EXPECT_EQ(j["command"], "subspace");
+  EXPECT_EQ(j["dimension"], 6);
+  EXPECT_EQ(j["lower_bound"], 3 * 8 - 24 + 6);
+  EXPECT_DOUBLE_EQ(j["free_vertices"].get<double>(), 2.0);
+  EXPECT_EQ(j["face_types"].size(), 6u);
+  EXPECT_EQ(j["non_maximal_faces"].size(), 6u);
+  EXPECT_TRUE(j.contains("planarity"));
+  EXPECT_TRUE(j.contains("seconds"));
+}
+
+TEST(SubspaceCommand, MixedSpaceReadsTheFacesFileAndRejectsAShortOne) {
+  TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  { std::ofstream(dir / "faces.txt") << "affine parallel vertical\n# comment\na p v\n"; }
+  const auto ok = runTool("-q subspace " + quoted(dir / "cube.obj") + " --space mixed --faces-file " +
+                          quoted(dir / "faces.txt") + " --report " + quoted(dir / "r.json"));
+  ASSERT_EQ(ok.exitCode, 0) << ok.err;
+  EXPECT_EQ(readJson(dir / "r.json")["face_types"][0], "affine");
+  { std::ofstream(dir / "short.txt") << "affine parallel\n"; }
+  const auto bad = runTool("-q subspace " + quoted(dir / "cube.obj") + " --space mixed --faces-file " +
+                           quoted(dir / "short.txt"));
+  EXPECT_EQ(bad.exitCode, 3);
+  EXPECT_NE(bad.err.find("2 face spaces"), std::string::npos) << bad.err;
+}
+
+TEST(ExploreCommand, WritesAPolyhedralMeshWithTheBandAdded) {
+  TempDir dir;
+  writeMesh(dir / "dome.obj", generate::hexagonalDome(2));
+  const auto result = runTool("-q explore " + quoted(dir / "dome.obj") +
+                              " --space vertical --eigenshapes 8 --band 3:6 --amplitude 0.05 -o " +
+                              quoted(dir / "out.obj") + " --report " + quoted(dir / "r.json"));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const PolygonMesh out = readMesh(dir / "out.obj");
+  const PolygonMesh in = readMesh(dir / "dome.obj");
+  EXPECT_GT((out.vertices - in.vertices).norm(), 1e-3);
+  // Single-precision OBJ output bounds what the file can show.
+  EXPECT_LE(planarityStats(out).max, 1e-3);
+  EXPECT_EQ(readJson(dir / "r.json")["frequencies"].size(), 8u);
+}
+
+TEST(ShapesCommand, SparseAndFundamentalShapesRun) {
+  TempDir dir;
+  writeMesh(dir / "rev.obj", generate::surfaceOfRevolution(12, 6));
+  for (const char* kind : {"sparse", "fundamental"}) {
+    const auto result = runTool(std::string("-q shapes ") + quoted(dir / "rev.obj") + " --space affine --kind " + kind +
+                                " --vertex 41 --direction 0,0,1 -o " + quoted(dir / "out.obj") + " --report " +
+                                quoted(dir / "r.json"));
+    ASSERT_EQ(result.exitCode, 0) << kind << ": " << result.err;
+    EXPECT_EQ(readJson(dir / "r.json")["kind"], kind);
+  }
+  EXPECT_EQ(readJson(dir / "r.json")["shape"]["dimension"].get<int>() > 0, true);
+  const auto bad = runTool("-q shapes " + quoted(dir / "rev.obj") + " --vertex 100000 -o " + quoted(dir / "x.obj"));
+  EXPECT_EQ(bad.exitCode, 2);
+}
+
+TEST(DualCommand, WritesTheDualAndAnExploredPrimal) {
+  TempDir dir;
+  PolygonMesh dodecahedron = generate::dodecahedron();
+  writeMesh(dir / "d.obj", dodecahedron);
+  const auto result = runTool("-q dual " + quoted(dir / "d.obj") + " -o " + quoted(dir / "dual.obj") + " --primal " +
+                              quoted(dir / "primal.obj") + " --space affine --eigenshape 12 --report " +
+                              quoted(dir / "r.json"));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const PolygonMesh dual = readMesh(dir / "dual.obj");
+  EXPECT_EQ(dual.vertexCount(), 12);
+  EXPECT_EQ(dual.faceCount(), 20);
+  const PolygonMesh primal = readMesh(dir / "primal.obj");
+  EXPECT_LE(planarityStats(primal).max, 1e-3);
+}
+
+TEST(EmbedCommand, LiftsATutteEmbeddingOfADisk) {
+  TempDir dir;
+  writeMesh(dir / "grid.obj", generate::hyparGrid(6));
+  const auto result = runTool("-q embed " + quoted(dir / "grid.obj") + " -o " + quoted(dir / "out.obj") +
+                              " --report " + quoted(dir / "r.json"));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto j = readJson(dir / "r.json");
+  EXPECT_EQ(j["flipped_faces"], 0);
+  EXPECT_GT(j["max_height"].get<double>(), 0.0);
+  EXPECT_LE(planarityStats(readMesh(dir / "out.obj")).max, 1e-3);
+  writeMesh(dir / "cube.obj", generate::cube());
+  EXPECT_EQ(runTool("-q embed " + quoted(dir / "cube.obj") + " -o " + quoted(dir / "x.obj")).exitCode, 3);
+}
+
+TEST(SubspaceDeform, DeformsInsideTheSpaceAndReportsIterations) {
+  TempDir dir;
+  writeMesh(dir / "dome.obj", generate::hexagonalDome(2));
+  {
+    std::ofstream(dir / "c.json") << R"({"fixed": [0, 1, 2, 3, 4, 5, 6, 7, 8, 9],
+                                        "handles": [{"vertex": 40, "position": [0.0, 0.0, 1.2]}]})";
+  }
+  const auto result = runTool("-q subspace-deform " + quoted(dir / "dome.obj") + " --space vertical --constraints " +
+                              quoted(dir / "c.json") + " -o " + quoted(dir / "out.obj") + " --report " +
+                              quoted(dir / "r.json") + " --max-iterations 20");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto j = readJson(dir / "r.json");
+  EXPECT_EQ(j["command"], "deform");
+  EXPECT_GT(j["iterations"].get<int>(), 0);
+  // The mesh comes from a single-precision OBJ, so B is as noisy as the file (~1e-7).
+  EXPECT_LE(j["max_subspace_residual"].get<double>(), 1e-5);
+  const auto bad = runTool("-q subspace-deform " + quoted(dir / "dome.obj") + " --constraints " +
+                           quoted(dir / "missing.json") + " -o " + quoted(dir / "x.obj"));
+  EXPECT_EQ(bad.exitCode, 3);
+}
+
+}  // namespace
+}  // namespace plano::test

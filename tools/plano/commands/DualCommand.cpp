@@ -1,0 +1,92 @@
+// plano dual MESH -o OUT [--space S --eigenshape K --amplitude A --primal P]: the polar dual
+// of a polyhedral mesh, and optionally an exploration of the dual's linear space whose
+// primal mesh (recovered by a linear solve) is written to P (linear-spaces paper, §3, Fig. 9).
+#include <chrono>
+#include <iostream>
+
+#include "core/Error.h"
+#include "mesh/MeshIO.h"
+#include "mesh/Planarity.h"
+#include "plano/Command.h"
+#include "plano/Report.h"
+#include "subspace/Eigenshapes.h"
+#include "subspace/LinearSpace.h"
+#include "subspace/MeshLaplacian.h"
+#include "subspace/PolarDual.h"
+
+namespace plano::cli {
+namespace {
+
+using namespace plano::subspace;
+
+struct DualOptions {
+  std::string input, output, report, primal;
+  std::string space = "parallel";
+  Index eigenshape = 3;
+  double amplitude = 0.05;
+};
+
+RunFunction setup(CLI::App& app) {
+  auto o = std::make_shared<DualOptions>();
+  app.add_option("mesh", o->input, "Polyhedral mesh (no face plane through the origin)")->required();
+  app.add_option("-o,--output", o->output, "Output dual mesh")->required();
+  app.add_option("--primal", o->primal, "Explore the dual: write the primal of the edited dual here");
+  app.add_option("--space", o->space, "Linear space of the dual to explore: affine | parallel | vertical")
+      ->check(CLI::IsMember({"affine", "parallel", "vertical"}))
+      ->capture_default_str();
+  app.add_option("--eigenshape", o->eigenshape, "Which eigenshape of the dual's space to add (0 = lowest)")
+      ->capture_default_str();
+  app.add_option("--amplitude", o->amplitude, "Peak displacement of the dual, relative to its bounding-box diagonal")
+      ->capture_default_str();
+  app.add_option("--report", o->report, "Write a JSON report to this file");
+  return [o](const GlobalOptions& global) {
+    const auto start = std::chrono::steady_clock::now();
+    const PolygonMesh mesh = readMesh(o->input);
+    const PolygonMesh dual = polarDual(mesh);
+    writeMesh(o->output, dual);
+    progress(global, "dual: " + std::to_string(dual.vertexCount()) + " vertices, " + std::to_string(dual.faceCount()) +
+                         " faces -> " + o->output);
+    nlohmann::json j;
+    PlanarityStats stats = planarityStats(dual);
+    nlohmann::json exploration;
+    if (!o->primal.empty()) {
+      const LinearSpace space = buildLinearSpace(dual, uniformAssignment(parseSpaceKind(o->space), dual.faceCount()));
+      EigenshapeSettings es;
+      es.count = o->eigenshape + 1;
+      const Eigenshapes shapes = computeEigenshapes(space.N, uniformLaplacian(dual.faces, dual.vertexCount()), es);
+      if (o->eigenshape >= shapes.count()) {
+        throwUsage("--eigenshape " + std::to_string(o->eigenshape) + " but the dual's " + o->space + " space has dimension " +
+                   std::to_string(space.N.dimension()));
+      }
+      const Positions edited = bandPass(space.N, shapes, space.N.project(dual.vertices), o->eigenshape,
+                                        o->eigenshape + 1, o->amplitude);
+      PolygonMesh primal = mesh;
+      primal.vertices = primalFromDual(mesh.faces, edited, mesh.vertices);
+      writeMesh(o->primal, primal);
+      stats = planarityStats(primal);
+      exploration = {{"space", o->space},
+                     {"dimension", space.dof.dimension},
+                     {"eigenshape", o->eigenshape},
+                     {"frequency", shapes.frequencies[o->eigenshape]},
+                     {"primal", o->primal},
+                     {"primal_max_planarity", stats.max}};
+      std::cout << "explored the dual's " << o->space << " space (dimension " << space.dof.dimension
+                << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    j = baseReport("dual", "cpu", o->primal.empty() ? dual : mesh, stats, seconds);
+    j["dual_vertices"] = dual.vertexCount();
+    j["dual_faces"] = dual.faceCount();
+    j["dual_max_planarity"] = planarityStats(dual).max;
+    if (!exploration.is_null()) j["exploration"] = exploration;
+    std::cout << "dual of " << o->input << ": " << dual.vertexCount() << " vertices, " << dual.faceCount()
+              << " faces -> " << o->output << "\n";
+    writeReport(o->report, j);
+    return 0;
+  };
+}
+
+const CommandRegistration registration{{"dual", "Polar dual of a polyhedral mesh and exploration of its spaces", setup, 63}};
+
+}  // namespace
+}  // namespace plano::cli

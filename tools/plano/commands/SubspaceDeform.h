@@ -1,0 +1,27 @@
+#pragma once
+// `plano deform --space S`: handle-based ASAP/ARAP deformation inside a linear space of
+// polyhedral meshes (linear-spaces paper, §3, Fig. 8). The deform command parses its
+// options into a request and calls runSubspaceDeform.
+#include <string>
+
+#include "plano/Command.h"
+
+namespace plano::cli {
+
+struct SubspaceDeformRequest {
+  std::string mesh;              ///< Input polyhedral mesh.
+  std::string constraints;       ///< Constraints JSON (mesh/Constraints.h).
+  std::string space = "affine";  ///< affine | parallel | vertical | mixed
+  std::string facesFile;         ///< Per-face types for mixed.
+  std::string energy = "asap";   ///< asap | arap
+  std::string output;            ///< Output mesh.
+  std::string report;            ///< JSON report path (optional).
+  int maxIterations = 100;
+  double tolerance = 1e-8;       ///< Relative energy decrease that stops the iteration.
+};
+
+/// Run the deformation and write the output (and report). Returns the exit code; throws
+/// plano::Error for bad input (mesh, constraints, space) or a numerical failure.
+int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions& global);
+
+}  // namespace plano::cli
