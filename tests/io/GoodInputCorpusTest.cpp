@@ -105,6 +105,15 @@ TEST(GoodInputCorpus, NonFiniteValueOfAnUnusedPlyPropertyIsAccepted) {
   }
 }
 
+TEST(GoodInputCorpus, PlyElementWithoutPropertiesAndHugeCountIsSkippedAtOnce) {
+  // Regression (fuzzing): an element of no properties and a count of billions hung the reader.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement marker 4000000000\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(parseMesh(ply, MeshFormat::Ply, "marker.ply").faceCount(), 1);
+}
+
 TEST(GoodInputCorpus, UnknownObjStatementIsSkippedWithAWarning) {
   std::vector<std::string> warnings;
   ReadOptions options;

@@ -166,6 +166,9 @@ PolygonMesh readBody(const PlyHeader& header, const MeshLayout& layout, Body& bo
                 std::to_string(minimum) + " bytes each, but only " + std::to_string(body.remaining()) +
                 " bytes follow (truncated file, or the header counts disagree with the body)");
     }
+    // An element without properties occupies no bytes, whatever its count: nothing to
+    // read (looping over a declared count of billions would hang; found by fuzzing).
+    if (element.properties.empty()) continue;
     const bool isVertex = static_cast<int>(e) == layout.vertexElement;
     const bool isFace = static_cast<int>(e) == layout.faceElement;
     if ((isVertex || isFace) && element.count > kMaxCount) {
