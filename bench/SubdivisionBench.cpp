@@ -1,8 +1,13 @@
-// Subdivision: linear schemes (refinement topology + target positions) on generated
-// meshes refined to ~4k, ~64k and ~1M faces.
+// Subdivision and multi-resolution editing: linear schemes (refinement topology + target
+// positions) refined to ~4k, ~64k and ~1M faces; planar-quad subdivision; multires vs
+// direct deformation at the Yas Island scale of the paper's Table 1.
 #include <benchmark/benchmark.h>
 
+#include "compute/Backend.h"
 #include "mesh/Generators.h"
+#include "projective/Deformation.h"
+#include "projective/MultiresDeformation.h"
+#include "projective/PqSubdivision.h"
 #include "projective/QuadRefinement.h"
 #include "projective/SubdivisionSchemes.h"
 
@@ -34,5 +39,104 @@ BENCHMARK_CAPTURE(BM_LinearSubdivision, catmull_clark, SubdivisionScheme::Catmul
     ->Arg(1)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LinearSubdivision, four_point, SubdivisionScheme::FourPoint)
     ->Arg(1)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+// ---- planar-quad subdivision (paper §5) ------------------------------------------
+
+namespace {
+
+/// PQ subdivision of a 32 x 32 translational surface (already a conjugate net: one
+/// iteration per level, measuring the pipeline) and of the cube (Catmull-Clark targets far
+/// from planar: the paper's Fig. 2 case, 6 * 4^levels faces).
+void BM_PqSubdivision(benchmark::State& state, bool cube) {
+  auto backend = plano::compute::createBackend(plano::compute::BackendChoice::Cpu);
+  const plano::PolygonMesh base = cube ? plano::generate::cube() : plano::generate::translationalSurface(32, 32);
+  plano::projective::PqSubdivisionSettings settings;
+  settings.levels = static_cast<int>(state.range(0));
+  plano::projective::PqSubdivisionInfo info;
+  for (auto _ : state) {
+    const auto result = plano::projective::subdividePlanarQuads(*backend, base, settings);
+    info = result.info;
+    benchmark::DoNotOptimize(result.positions.back().data());
+  }
+  state.counters["faces"] = static_cast<double>(info.levels.back().faces);
+  state.counters["iterations"] = info.totalIterations;
+  state.counters["max_planarity_pct"] = info.levels.back().planarity.max;
+}
+
+BENCHMARK_CAPTURE(BM_PqSubdivision, translational, false)->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_PqSubdivision, cube, true)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// ---- multi-resolution vs direct deformation (paper §6, Table 1) -------------------
+
+/// Yas-Island scale: 16 x 16 = 256 coarse quads, two four-point PQ levels = 4096 fine quads;
+/// the finest row y = 0 fixed, the far corner lifted by 0.3 (a tenth of the diagonal).
+struct YasScale {
+  plano::projective::PqSubdivisionResult subdivision;
+  plano::PositionalConstraints constraints;
+
+  static const YasScale& get() {
+    static const YasScale instance = [] {
+      auto backend = plano::compute::createBackend(plano::compute::BackendChoice::Cpu);
+      plano::projective::PqSubdivisionSettings settings;
+      settings.levels = 2;
+      settings.scheme = plano::projective::SubdivisionScheme::FourPoint;
+      settings.planarityTolerance = 0.5;
+      YasScale s{plano::projective::subdividePlanarQuads(*backend, plano::generate::translationalSurface(16, 16), settings),
+                 {}};
+      const plano::Positions& x = s.subdivision.positions.back();
+      for (plano::Index v = 0; v < x.rows(); ++v) {
+        if (x(v, 1) < 1e-9) s.constraints.fixed.push_back(v);
+      }
+      plano::Index corner = 0;
+      (x.rowwise() - Eigen::RowVector3d(1.0, 1.0, x(0, 2))).rowwise().squaredNorm().minCoeff(&corner);
+      s.constraints.handles.push_back({corner, x.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.3)});
+      return s;
+    }();
+    return instance;
+  }
+};
+
+void BM_MultiresDeform(benchmark::State& state) {
+  const YasScale& yas = YasScale::get();
+  auto backend = plano::compute::createBackend(plano::compute::BackendChoice::Cpu);
+  plano::projective::MultiresInfo info;
+  for (auto _ : state) {
+    const auto result =
+        plano::projective::multiresDeform(*backend, yas.subdivision.hierarchy, yas.subdivision.positions, yas.constraints);
+    info = result.info;
+    benchmark::DoNotOptimize(result.positions.data());
+  }
+  state.counters["level"] = info.level;
+  state.counters["coarse_faces"] = static_cast<double>(info.coarseFaces);
+  state.counters["fine_faces"] = static_cast<double>(info.fineFaces);
+  state.counters["coarse_iterations"] = info.coarseIterations;
+  state.counters["coarse_ms"] = 1e3 * info.coarseSeconds;
+  state.counters["prolongation_ms"] = 1e3 * info.prolongationSeconds;
+  state.counters["max_planarity_pct"] = info.planarity.max;
+  state.counters["handle_error"] = info.maxHandleError;
+}
+
+void BM_DirectDeform(benchmark::State& state) {
+  const YasScale& yas = YasScale::get();
+  auto backend = plano::compute::createBackend(plano::compute::BackendChoice::Cpu);
+  const plano::PolygonMesh fine = yas.subdivision.finestMesh();
+  plano::projective::DeformationSettings settings;  // same stopping rule as the multires default
+  settings.tolerance = plano::projective::MultiresSettings{}.tolerance;
+  settings.planarityTolerance = plano::projective::MultiresSettings{}.planarityTolerance;
+  plano::projective::DeformationInfo info;
+  for (auto _ : state) {
+    const auto result = plano::projective::deform(*backend, fine, yas.constraints, settings);
+    info = result.info;
+    benchmark::DoNotOptimize(result.mesh.vertices.data());
+  }
+  state.counters["iterations"] = info.iterations;
+  state.counters["max_planarity_pct"] = info.planarity.max;
+  state.counters["constraint_error"] = info.maxConstraintError;
+}
+
+BENCHMARK(BM_MultiresDeform)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_DirectDeform)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace

@@ -208,7 +208,13 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
     const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(targets.data(), active);
     if (!solver || rows != factoredRows) {
       const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
-      solver = backend_.createSpdSolver(K, settings_.linearSolver);
+      // The stiff polish system can be too ill-conditioned to factor; polishing is an
+      // optional refinement, so the ADMM solution stands.
+      try {
+        solver = backend_.createSpdSolver(K, settings_.linearSolver);
+      } catch (const Error&) {
+        return false;
+      }
       factoredRows = rows;
     }
     // Method of multipliers on the equality-constrained QP, warm-started from the ADMM duals.

@@ -73,7 +73,8 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     // Phase 1 (§6.1): fit, closest rigid/similar map, global step.
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
-      const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy);
+      const Positions normalized = space_.normalization().toNormalized(positions);
+      const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy, &normalized);
       const GlobalStepInfo step = global_.solve(ideal, targets, maps);
       const Positions next = space_.positions(maps.maps);
       const DeformationIteration it = record(DeformationPhase::Ideal, step, next);

@@ -16,7 +16,45 @@ struct Linearization {
   Eigen::RowVector3d image;
   Eigen::Matrix3d linear;
   double similarityScale = 1.0;
+  /// Corner-set Procrustes instead of the Jacobian: the scale is Umeyama's,
+  /// sum of signed singular values of `linear` / sourceSpread.
+  bool procrustes = false;
+  double sourceSpread = 1.0;
 };
+
+/// The fit sends the centroid or a corner through the plane at infinity (weights of
+/// mixed sign or ~0): its Jacobian at the centroid says nothing about the face.
+bool degenerate(const ShapeSpace& space, Index f, const Eigen::Matrix4d& T, const Eigen::RowVector3d& centroid) {
+  const double w = homogeneous(centroid).dot(T.col(3));
+  if (!(std::abs(w) > 1e-12) || !std::isfinite(w)) return true;
+  for (Index v : space.faces()[f]) {
+    if (!(homogeneous(space.basePositions().row(v)).dot(T.col(3)) * w > 0.0)) return true;
+  }
+  return false;
+}
+
+/// Kabsch/Umeyama between the source and target corners of face f.
+Linearization cornerProcrustes(const ShapeSpace& space, Index f, const Positions& target) {
+  const auto face = space.faces()[f];
+  Linearization lin;
+  lin.procrustes = true;
+  lin.centroid.setZero();
+  lin.image.setZero();
+  for (Index v : face) {
+    lin.centroid += space.basePositions().row(v);
+    lin.image += target.row(v);
+  }
+  lin.centroid /= static_cast<double>(face.size());
+  lin.image /= static_cast<double>(face.size());
+  lin.linear.setZero();
+  lin.sourceSpread = 0.0;
+  for (Index v : face) {
+    const Eigen::RowVector3d p = space.basePositions().row(v) - lin.centroid;
+    lin.linear += p.transpose() * (target.row(v) - lin.image);
+    lin.sourceSpread += p.squaredNorm();
+  }
+  return lin;
+}
 
 Linearization linearize(const ShapeSpace& space, Index f, const Eigen::Matrix4d& T) {
   const auto face = space.faces()[f];
@@ -61,7 +99,8 @@ Linearization linearize(const ShapeSpace& space, Index f, const Eigen::Matrix4d&
 }  // namespace
 
 std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const ShapeSpace& space,
-                                              const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind) {
+                                              const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind,
+                                              const Positions* target, Index* fallbacks) {
   const Index faceCount = space.faceCount();
   if (static_cast<Index>(fitted.size()) != faceCount) {
     throwUsage("closest ideal maps: " + std::to_string(fitted.size()) + " maps given for " +
@@ -69,8 +108,21 @@ std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const S
   }
   std::vector<Linearization> lin(faceCount);
   std::vector<Eigen::Matrix3d> linear(faceCount);
+  if (target && target->rows() != space.vertexCount()) {
+    throwUsage("closest ideal maps: target has " + std::to_string(target->rows()) + " vertices, the mesh " +
+               std::to_string(space.vertexCount()));
+  }
+  if (fallbacks) *fallbacks = 0;
   for (Index f = 0; f < faceCount; ++f) {
-    lin[f] = linearize(space, f, fitted[f]);
+    Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+    for (Index v : space.faces()[f]) centroid += space.basePositions().row(v);
+    centroid /= static_cast<double>(space.faces().degree(f));
+    if (target && degenerate(space, f, fitted[f], centroid)) {
+      lin[f] = cornerProcrustes(space, f, *target);
+      if (fallbacks) ++*fallbacks;
+    } else {
+      lin[f] = linearize(space, f, fitted[f]);
+    }
     linear[f] = lin[f].linear;
   }
   std::vector<Eigen::Matrix3d> rotations(faceCount);
@@ -79,7 +131,11 @@ std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const S
 
   std::vector<Eigen::Matrix4d> ideal(faceCount, Eigen::Matrix4d::Identity());
   for (Index f = 0; f < faceCount; ++f) {
-    const double s = kind == IdealMapKind::Similar ? lin[f].similarityScale : 1.0;
+    double s = 1.0;
+    if (kind == IdealMapKind::Similar) {
+      s = lin[f].procrustes ? std::max(singularValues[f].sum(), 0.0) / std::max(lin[f].sourceSpread, 1e-300)
+                            : lin[f].similarityScale;
+    }
     const Eigen::Matrix3d M = s * rotations[f];
     ideal[f].topLeftCorner<3, 3>() = M;
     ideal[f].block<1, 3>(3, 0) = lin[f].image - lin[f].centroid * M;

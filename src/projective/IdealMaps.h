@@ -32,9 +32,17 @@ enum class IdealMapKind {
 ///   space    in: base mesh (normalized coordinates).
 ///   fitted   in: #F fitted maps T_f (normalized coordinates, row-vector convention).
 ///   kind     in: rigid or similar.
+///   target   in (optional): #V x 3 normalized target positions the maps were fitted to.
+///            A least-squares fit of a non-planar face with more than four corners can
+///            send part of the face through the plane at infinity (corner or centroid
+///            weights of mixed sign); such a fit has no meaningful Jacobian, and with
+///            `target` the face falls back to the classical corner-set Procrustes
+///            (Kabsch; Umeyama's scale for similarities) between its source and target
+///            corners. `fallbacks` (optional) receives the number of such faces.
 /// Returns #F affine maps [[s R, 0], [t, 1]] (row-vector convention, A(3, 3) = 1).
-/// Throws Error(Numerical) naming the face when its centroid maps to infinity.
+/// Throws Error(Numerical) naming the face when a fit is degenerate and no target is given.
 std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const ShapeSpace& space,
-                                              const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind);
+                                              const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind,
+                                              const Positions* target = nullptr, Index* fallbacks = nullptr);
 
 }  // namespace plano::projective

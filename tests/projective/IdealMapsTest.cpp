@@ -105,5 +105,24 @@ TEST_F(IdealMapsOfMovedMesh, PerspectiveFitsGiveAffineTargets) {
   }
 }
 
+TEST_F(IdealMapsOfMovedMesh, DegenerateFitsFallBackToCornerProcrustes) {
+  const ShapeSpace space(mesh);
+  const Positions target = moved(mesh.vertices, 1.0);
+  // Fits whose weights change sign across every face (a face through the plane at infinity).
+  std::vector<Eigen::Matrix4d> broken(space.faceCount(), Eigen::Matrix4d::Identity());
+  for (Index f = 0; f < space.faceCount(); ++f) {
+    const auto face = space.faces()[f];
+    const Eigen::RowVector3d a = space.basePositions().row(face[0]);
+    const Eigen::RowVector3d b = space.basePositions().row(face[3]);
+    broken[f].block<3, 1>(0, 3) = 1e3 * (b - a).transpose();
+    broken[f](3, 3) = 1.0 - 1e3 * (b - a).dot(0.5 * (a + b));
+  }
+  const Positions normalizedTarget = space.normalization().toNormalized(target);
+  Index fallbacks = 0;
+  const auto rigid = closestIdealMaps(backend, space, broken, IdealMapKind::Rigid, &normalizedTarget, &fallbacks);
+  EXPECT_EQ(fallbacks, space.faceCount());
+  EXPECT_LT(test::maxAbsDifference(space.positions(rigid), target), 1e-10);
+}
+
 }  // namespace
 }  // namespace plano::projective

@@ -15,6 +15,8 @@
 #include "plano/Command.h"
 #include "plano/Report.h"
 #include "projective/Deformation.h"
+#include "projective/MultiresDeformation.h"
+#include "projective/PqSubdivision.h"
 
 namespace plano::cli {
 namespace {
@@ -31,6 +33,12 @@ struct DeformOptions {
   std::string report;
   bool keepPartial = false;
   bool inPlace = false;
+  // --multires (paper §6): MESH is the subdivision of --base by `plano subdivide`.
+  bool multires = false;
+  std::string base;
+  std::string scheme = "catmull-clark";
+  int multiresLevel = -1;
+  const CLI::Option* smoothnessOption = nullptr;  ///< Tells whether --smoothness was given.
 };
 
 /// What a deformation method hands back to the common output code.
@@ -107,9 +115,103 @@ DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& 
   return outcome;
 }
 
+// ---- multi-resolution editing (paper §6) -----------------------------------------
+
+/// Rebuild the subdivision hierarchy of `base` whose finest level is `mesh`: the number of
+/// levels follows from the face counts, the topology must match face by face, and the
+/// user's fine positions replace the recomputed ones (the coarse levels come from the
+/// recomputation).
+projective::PqSubdivisionResult rebuildHierarchy(const DeformOptions& options, const GlobalOptions& global,
+                                                 compute::Backend& backend, const PolygonMesh& mesh) {
+  const PolygonMesh base = readMesh(options.base);
+  // Level 1 has one quad per base corner, every further level four times as many.
+  int levels = 0;
+  for (Index faces = base.faceCount(); faces < mesh.faceCount() && levels < 12; ++levels) {
+    faces = levels == 0 ? base.faces.cornerCount() : 4 * faces;
+  }
+  projective::PqSubdivisionSettings settings;
+  settings.scheme = projective::parseSubdivisionScheme(options.scheme);
+  settings.levels = levels;
+  settings.planarityTolerance = projective::isInterpolating(settings.scheme) ? 0.5 : 0.1;
+  const auto hierarchyOnly = projective::SubdivisionHierarchy(base.faces, base.vertexCount(), levels);
+  if (levels == 0 || !(hierarchyOnly.faces(levels) == mesh.faces)) {
+    throwBadInput(options.input + " is not a subdivision of " + options.base + " (" +
+                  std::to_string(mesh.faceCount()) + " faces; no level of the hierarchy of the base has the same faces)");
+  }
+  progress(global, "multires: rebuilding " + std::to_string(levels) + " " + options.scheme + " levels of " + options.base);
+  projective::PqSubdivisionResult subdivision = projective::subdividePlanarQuads(backend, base, settings);
+  const double offset = (subdivision.positions.back() - mesh.vertices).rowwise().norm().maxCoeff();
+  if (offset > 1e-6 * boundingBoxDiagonal(mesh.vertices)) {
+    progress(global, "warning: " + options.input + " differs from the subdivision of " + options.base + " by up to " +
+                         std::to_string(offset) + "; its positions are used on the finest level");
+  }
+  subdivision.positions.back() = mesh.vertices;
+  return subdivision;
+}
+
+DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& global, compute::Backend& backend,
+                          const PolygonMesh& mesh, const PositionalConstraints& constraints) {
+  if (options.base.empty()) throwUsage("deform --multires needs --base BASE, the mesh that MESH was subdivided from");
+  const auto start = std::chrono::steady_clock::now();
+  const projective::PqSubdivisionResult subdivision = rebuildHierarchy(options, global, backend, mesh);
+  const double hierarchySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  projective::MultiresSettings settings;
+  settings.energy = options.energy == "similar" ? projective::IdealMapKind::Similar : projective::IdealMapKind::Rigid;
+  if (options.smoothnessOption != nullptr && options.smoothnessOption->count() > 0) settings.smoothness = options.smoothness;
+  settings.level = options.multiresLevel;
+  settings.maxCoarseIterations = options.maxIterations;
+  settings.tolerance = options.tolerance;
+  settings.planarityTolerance = options.planarityTolerance;
+  const projective::MultiresResult result =
+      projective::multiresDeform(backend, subdivision.hierarchy, subdivision.positions, constraints, settings);
+  const projective::MultiresInfo& info = result.info;
+  progress(global, "multires: deformed on level " + std::to_string(info.level) + " (" +
+                       std::to_string(info.coarseFaces) + " faces) in " + std::to_string(info.coarseIterations) +
+                       " iterations, prolonged to " + std::to_string(info.fineFaces) + " faces");
+
+  DeformOutcome outcome;
+  outcome.mesh = PolygonMesh{result.positions, mesh.faces};
+  outcome.iterations = info.coarseIterations + info.projectionIterations;
+  outcome.succeeded = info.status == projective::MultiresStatus::Converged;
+  outcome.message = "multires: not converged (max planarity " + std::to_string(info.planarity.max) + "%)";
+  nlohmann::json checks = nlohmann::json::array();
+  for (const auto& check : info.levelChecks) {
+    checks.push_back({{"level", check.level}, {"admissible", check.admissible}, {"reason", check.reason}});
+  }
+  nlohmann::json fineAttempts = nlohmann::json::array();
+  for (const auto& a : info.fineStep.attempts) {
+    fineAttempts.push_back({{"epsilon", a.epsilon}, {"status", projective::toString(a.status)}, {"iterations", a.iterations}});
+  }
+  outcome.details = {{"method", "multires"},
+                     {"energy", options.energy},
+                     {"scheme", options.scheme},
+                     {"smoothness", settings.smoothness},
+                     {"status", projective::toString(info.status)},
+                     {"level", info.level},
+                     {"levels", subdivision.hierarchy.finestLevel()},
+                     {"level_checks", checks},
+                     {"coarse_faces", info.coarseFaces},
+                     {"fine_faces", info.fineFaces},
+                     {"coarse_iterations", info.coarseIterations},
+                     {"epsilon", info.coarseEpsilons},
+                     {"displacements", info.coarseDisplacements},
+                     {"fine_epsilon", info.fineStep.epsilon},
+                     {"fine_epsilon_attempts", fineAttempts},
+                     {"projection_iterations", info.projectionIterations},
+                     {"max_handle_error", info.maxHandleError},
+                     {"max_fixed_error", info.maxFixedError},
+                     {"times", {{"hierarchy", hierarchySeconds},
+                                {"coarse_deform", info.coarseSeconds},
+                                {"prolongation", info.prolongationSeconds},
+                                {"deform", info.seconds}}}};
+  return outcome;
+}
+
 /// The one place where a deformation method is chosen.
 DeformOutcome runMethod(const DeformOptions& options, const GlobalOptions& global, compute::Backend& backend,
                         const PolygonMesh& mesh, const PositionalConstraints& constraints) {
+  if (options.multires) return runMultires(options, global, backend, mesh, constraints);
   return runSingleLevel(options, global, backend, mesh, constraints);
 }
 
@@ -147,6 +249,17 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", options->report, "Write a JSON report to this file");
   app.add_flag("--keep-partial", options->keepPartial, "Write the last iterate even when the deformation fails");
   app.add_flag("--in-place", options->inPlace, "Allow the output to overwrite the input mesh");
+  // Multi-resolution editing (paper §6).
+  app.add_flag("--multires", options->multires,
+               "Multi-resolution editing: deform on the coarsest admissible level of the subdivision hierarchy of "
+               "--base and prolong (smoothness defaults to 3.5)");
+  app.add_option("--base", options->base, "With --multires: the coarse mesh that MESH was subdivided from");
+  app.add_option("--scheme", options->scheme, "With --multires: the scheme MESH was subdivided with")
+      ->check(CLI::IsMember({"catmull-clark", "four-point"}))
+      ->capture_default_str();
+  app.add_option("--multires-level", options->multiresLevel,
+                 "With --multires: deform on this level instead of the automatic choice");
+  options->smoothnessOption = app.get_option("--smoothness");
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     if (!options->inPlace && samePath(options->input, options->output)) {
