@@ -14,6 +14,7 @@
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
 #include "plano/Report.h"
+#include "plano/commands/SubspaceDeform.h"
 #include "projective/Deformation.h"
 #include "projective/MultiresDeformation.h"
 #include "projective/PqSubdivision.h"
@@ -38,7 +39,12 @@ struct DeformOptions {
   std::string base;
   std::string scheme = "catmull-clark";
   int multiresLevel = -1;
+  // --space (linear-spaces paper §3): deformation inside a linear space of polyhedral meshes.
+  std::string space;
+  std::string facesFile;
   const CLI::Option* smoothnessOption = nullptr;  ///< Tells whether --smoothness was given.
+  const CLI::Option* toleranceOption = nullptr;   ///< Tells whether --tolerance was given.
+  const CLI::Option* maxIterationsOption = nullptr;
 };
 
 /// What a deformation method hands back to the common output code.
@@ -259,8 +265,31 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--multires-level", options->multiresLevel,
                  "With --multires: deform on this level instead of the automatic choice");
+  // Deformation inside a linear space (linear-spaces paper §3, Fig. 8).
+  app.add_option("--space", options->space,
+                 "Deform inside a linear space of polyhedral meshes instead of the projective shape space "
+                 "(ASAP for --energy similar, ARAP for rigid)")
+      ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}));
+  app.add_option("--faces-file", options->facesFile, "With --space mixed: per-face space types");
   options->smoothnessOption = app.get_option("--smoothness");
+  options->toleranceOption = app.get_option("--tolerance");
+  options->maxIterationsOption = app.get_option("--max-iterations");
   return [options](const GlobalOptions& global) {
+    if (!options->space.empty()) {
+      if (options->multires) throwUsage("deform: --space and --multires cannot be combined");
+      SubspaceDeformRequest request;
+      request.mesh = options->input;
+      request.constraints = options->constraints;
+      request.space = options->space;
+      request.facesFile = options->facesFile;
+      request.energy = options->energy == "similar" ? "asap" : "arap";
+      request.output = options->output;
+      request.report = options->report;
+      request.inPlace = options->inPlace;
+      if (options->maxIterationsOption->count() > 0) request.maxIterations = options->maxIterations;
+      if (options->toleranceOption->count() > 0) request.tolerance = options->tolerance;
+      return runSubspaceDeform(request, global);
+    }
     const auto start = std::chrono::steady_clock::now();
     if (!options->inPlace && samePath(options->input, options->output)) {
       throwUsage("output " + options->output + " is the input mesh; pass --in-place to overwrite it");

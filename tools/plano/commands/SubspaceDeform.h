@@ -16,6 +16,7 @@ struct SubspaceDeformRequest {
   std::string energy = "asap";   ///< asap | arap
   std::string output;            ///< Output mesh.
   std::string report;            ///< JSON report path (optional).
+  bool inPlace = false;          ///< Allow the output to overwrite the input mesh.
   int maxIterations = 100;
   double tolerance = 1e-8;       ///< Relative energy decrease that stops the iteration.
 };
