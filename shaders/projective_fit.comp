@@ -1,9 +1,12 @@
 #version 450
 // Batched local step of the projective-maps paper (§4.1, Eq. 3), the math of
 // src/projective/LocalFit.cpp: per face, project source and target corners onto their
-// best-fit planes, then find the 15 free entries t of the 4x4 map T (T(3,3) = 1) from the
-// 3k equations (p_i, 1) T[:, j] - q_ij (p_i, 1) T[:, 3] = 0, as the correction from the
-// identity of least norm (least squares when inconsistent).
+// best-fit planes, centre both at their own centroids (p' = p - c_p, q' = q - c_q), then
+// find the 15 free entries t of the 4x4 map T' (T'(3,3) = 1) from the 3k equations
+// (p'_i, 1) T'[:, j] - q'_ij (p'_i, 1) T'[:, 3] = 0, as the correction from the identity of
+// least norm (least squares when inconsistent). Centring excludes the degenerate exact fit
+// that collapses the face onto (p, 1) T = 0 (all reciprocal scales 0); the map is then
+// converted back, T = S_p T' S_q^{-1}, and rescaled to T(3,3) = 1 (see LocalFit.h).
 //
 // One invocation per face. The 3k x 15 system is never stored: its rows are streamed
 // into a 15 x 15 triangular factor R by Givens rotations (M = Q [R; 0], so the minimum-norm
@@ -38,6 +41,9 @@ layout(push_constant) uniform Push {
   uint faceCount;
   double rankThreshold;
 } pc;
+
+// kOriginAtInfinityTolerance of LocalFit.h.
+#define ORIGIN_AT_INFINITY_TOLERANCE 1e-12LF
 
 const int N = 15;
 double privateA[N * N];  // row-major: R, then its decomposition
@@ -254,7 +260,7 @@ void main() {
       const int v = indices[begin + corner];
       const dvec3 p = projected(point(false, v), sourceCentroid, sourceNormal);
       const dvec3 q = projected(point(true, v), targetCentroid, targetNormal);
-      for (int j = 0; j < 3; ++j) streamRow(equation(p, q, j));
+      for (int j = 0; j < 3; ++j) streamRow(equation(p - sourceCentroid, q - targetCentroid, j));
     }
 
     const int rank = pivotedQr(pc.rankThreshold);
@@ -265,6 +271,21 @@ void main() {
     t(5) += 1.0;
     t(10) += 1.0;
     t(15) = 1.0;
+
+    // Back to the original coordinates: T = S_p T' S_q^{-1}, where (p, 1) S_p = (p - c_p, 1)
+    // replaces row 3 by T'[3, :] - c_p . T'[0..2, :], and S_q^{-1} adds c_qj T[:, 3] to
+    // column j < 3. Then T(3,3) = 1, unless the origin goes to infinity (flagged below).
+    for (int col = 0; col < 4; ++col) {
+      t(4 * col + 3) -= dot(sourceCentroid, dvec3(t(4 * col), t(4 * col + 1), t(4 * col + 2)));
+    }
+    for (int j = 0; j < 3; ++j) {
+      for (int r = 0; r < 4; ++r) t(4 * j + r) += targetCentroid[j] * t(12 + r);
+    }
+    double norm2 = 0.0;
+    for (int l = 0; l < 16; ++l) norm2 += t(l) * t(l);
+    const bool originAtInfinity = !(abs(t(15)) > ORIGIN_AT_INFINITY_TOLERANCE * sqrt(norm2));
+    const double normalizer = originAtInfinity ? sqrt(norm2) : t(15);
+    for (int l = 0; l < 16; ++l) t(l) /= normalizer;
 
     const dvec4 column3 = dvec4(t(12), t(13), t(14), t(15));
     double squaredResidual = 0.0;
@@ -280,7 +301,8 @@ void main() {
       }
     }
     for (int l = 0; l < 16; ++l) maps[16 * i + l] = t(l);
-    residuals[i] = k > 0 ? sqrt(squaredResidual / double(3 * k)) : 0.0;
+    residuals[i] = originAtInfinity ? packDouble2x32(uvec2(0u, 0x7FF00000u))  // +infinity
+                                    : (k > 0 ? sqrt(squaredResidual / double(3 * k)) : 0.0);
     ranks[i] = rank;
   }
 }

@@ -24,7 +24,9 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 struct ProjectiveFits {
   std::vector<Eigen::Matrix4d> maps;      ///< #F maps.
   std::vector<double> reciprocalScales;   ///< One per corner, in the FaceList's CSR order.
-  std::vector<double> residuals;          ///< Per face: RMS of the fit's equation residuals.
+  /// Per face: RMS of the fit's equation residuals; +infinity when T_f(3, 3) = 1 is
+  /// impossible (the map sends the origin to infinity; that map is then scaled to unit norm).
+  std::vector<double> residuals;
   std::vector<int> ranks;                 ///< Per face: numerical rank of the fit's system.
 };
 
@@ -73,7 +75,8 @@ class Backend {
 
   /// Batched local step: the projective map of every face from `source` to `target`
   /// corners (both #V x 3), each face first projected onto its best-fitting plane; the
-  /// solution closest to the identity when not unique, least squares when over-determined.
+  /// solution closest to the identity when not unique, least squares when over-determined,
+  /// both in coordinates centred at each face's own corner centroids (see LocalFit.h).
   virtual void fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
                                  ProjectiveFits& out) = 0;
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 
 namespace plano::projective {
 
@@ -29,20 +30,40 @@ ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::spa
     q = projectOntoBestFitPlane(target);
   }
 
-  // Unknown vector: the 16 entries of T in column-major order, T(r, c) at 4c + r, without
-  // T(3, 3) (index 15), which is fixed to 1 and moves to the right-hand side.
+  // Per-face centring: fit T' between p'_i = p_i - c_p and q'_i = q_i - c_q. The source
+  // plane then passes through the origin, so no map with T'(3, 3) = 1 can send every
+  // (p'_i, 1) to zero: uncentred, the map n_h r^T built on the homogeneous source plane
+  // n_h = (n, -d) collapses the face (all shat_i = 0) and is an exact but degenerate
+  // solution whenever more than four corners over-determine the homography. Centred,
+  // sum_i (p'_i, 1) = k e_4, so the normalization T'(3, 3) = 1 means "mean reciprocal scale
+  // 1", and "closest to the identity" no longer depends on where the face sits.
+  Eigen::Vector3d cp = Eigen::Vector3d::Zero();
+  Eigen::Vector3d cq = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < k; ++i) {
+    cp += p[i];
+    cq += q[i];
+  }
+  if (k > 0) {
+    cp /= static_cast<double>(k);
+    cq /= static_cast<double>(k);
+  }
+
+  // Unknown vector: the 16 entries of T' in column-major order, T'(r, c) at 4c + r, without
+  // T'(3, 3) (index 15), which is fixed to 1 and moves to the right-hand side.
   const Eigen::Index rows = static_cast<Eigen::Index>(3 * k);
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(rows, 15);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(rows);
   for (std::size_t i = 0; i < k; ++i) {
-    const Eigen::Vector4d ph(p[i].x(), p[i].y(), p[i].z(), 1.0);
+    const Eigen::Vector3d pc = p[i] - cp;
+    const Eigen::Vector3d qc = q[i] - cq;
+    const Eigen::Vector4d ph(pc.x(), pc.y(), pc.z(), 1.0);
     for (int j = 0; j < 3; ++j) {
       const Eigen::Index row = static_cast<Eigen::Index>(3 * i + j);
       for (int r = 0; r < 4; ++r) {
         M(row, 4 * j + r) += ph[r];
-        const double weightCoefficient = -q[i][j] * ph[r];
+        const double weightCoefficient = -qc[j] * ph[r];
         if (4 * 3 + r == 15) {
-          b[row] -= weightCoefficient;  // T(3, 3) = 1
+          b[row] -= weightCoefficient;  // T'(3, 3) = 1
         } else {
           M(row, 4 * 3 + r) += weightCoefficient;
         }
@@ -50,7 +71,7 @@ ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::spa
     }
   }
 
-  // Closest to the identity: T = I + D with D of least norm solving M D = b - M vec(I).
+  // Closest to the identity: T' = I + D with D of least norm solving M D = b - M vec(I).
   Eigen::VectorXd identity = Eigen::VectorXd::Zero(15);
   identity[0] = identity[5] = identity[10] = 1.0;
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
@@ -61,18 +82,34 @@ ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::spa
 
   ProjectiveFit fit;
   fit.rank = static_cast<int>(cod.rank());
+  Eigen::Matrix4d centred;
   for (int c = 0; c < 4; ++c) {
     for (int r = 0; r < 4; ++r) {
       const int index = 4 * c + r;
-      fit.map(r, c) = index == 15 ? 1.0 : t[index];
+      centred(r, c) = index == 15 ? 1.0 : t[index];
     }
   }
-  fit.residual = rows > 0 ? std::sqrt((M * t - b).squaredNorm() / static_cast<double>(rows)) : 0.0;
+  // Back to the original coordinates: T = S_p T' S_q^{-1}, with (p, 1) S_p = (p - c_p, 1)
+  // and (q - c_q, 1) S_q^{-1} = (q, 1), then T(3, 3) = 1 again.
+  Eigen::Matrix4d Sp = Eigen::Matrix4d::Identity();
+  Sp.block<1, 3>(3, 0) = -cp.transpose();
+  Eigen::Matrix4d SqInverse = Eigen::Matrix4d::Identity();
+  SqInverse.block<1, 3>(3, 0) = cq.transpose();
+  const Eigen::Matrix4d T = Sp * centred * SqInverse;
+  const bool originAtInfinity = !(std::abs(T(3, 3)) > kOriginAtInfinityTolerance * T.norm());
+  fit.map = originAtInfinity ? Eigen::Matrix4d(T / T.norm()) : Eigen::Matrix4d(T / T(3, 3));
+
   fit.reciprocalScales.resize(k);
+  double squaredResidual = 0.0;
   for (std::size_t i = 0; i < k; ++i) {
-    const Eigen::Vector4d ph(p[i].x(), p[i].y(), p[i].z(), 1.0);
-    fit.reciprocalScales[i] = ph.dot(fit.map.col(3));
+    const Eigen::RowVector4d ph(p[i].x(), p[i].y(), p[i].z(), 1.0);
+    const Eigen::RowVector4d image = ph * fit.map;
+    fit.reciprocalScales[i] = image[3];
+    squaredResidual += (image.head<3>() - image[3] * q[i].transpose()).squaredNorm();
   }
+  fit.residual = rows > 0 ? std::sqrt(squaredResidual / static_cast<double>(rows)) : 0.0;
+  // The paper's normalization T(3, 3) = 1 does not exist for this face: flag it.
+  if (originAtInfinity) fit.residual = std::numeric_limits<double>::infinity();
   return fit;
 }
 

@@ -11,9 +11,14 @@ namespace plano::projective {
 struct ProjectiveFit {
   Eigen::Matrix4d map = Eigen::Matrix4d::Identity();
   std::vector<double> reciprocalScales;  ///< One per corner.
-  double residual = 0.0;  ///< RMS residual of the 3k fit equations (0 for an exact fit).
+  /// RMS residual of the 3k fit equations (0 for an exact fit); +infinity when the map
+  /// sends the origin to infinity (T(3, 3) ~ 0, see fitProjectiveMap).
+  double residual = 0.0;
   int rank = 0;           ///< Numerical rank of the 3k x 15 system.
 };
+
+/// Relative size of T(3, 3) below which a fitted map counts as sending the origin to infinity.
+inline constexpr double kOriginAtInfinityTolerance = 1e-12;
 
 struct LocalFitSettings {
   /// Project both corner sets onto their best-fitting planes first (§5 step 1), which
@@ -29,6 +34,14 @@ struct LocalFitSettings {
 /// (p_i, 1) T[:, j] - q_ij (p_i, 1) T[:, 3] = 0, j = 0..2. When they do not determine T,
 /// the solution closest to the identity (Frobenius) is returned, by a complete orthogonal
 /// factorization; when they are inconsistent, the least-squares solution.
+///
+/// The fit is solved in coordinates centred at each face's own corner centroids (source
+/// and target), where T'(3, 3) = 1 means "mean reciprocal scale 1": uncentred, more than
+/// four corners that are not an exact projective image admit the degenerate exact solution
+/// T = n_h r^T (n_h the homogeneous source plane), which collapses the face (all shat_i = 0).
+/// T' is then converted back and rescaled to T(3, 3) = 1, and shat_i = (p_i, 1) T[:, 3].
+/// If |T(3, 3)| <= kOriginAtInfinityTolerance * ||T|| (the map sends the global origin to
+/// infinity), T is scaled to unit Frobenius norm instead and the residual is +infinity.
 /// Coordinates should be centred and scaled to unit size (see projective-notes).
 ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::span<const Eigen::Vector3d> target,
                                const LocalFitSettings& settings = {});

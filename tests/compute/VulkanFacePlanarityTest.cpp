@@ -1,6 +1,7 @@
 // Vulkan per-face planarity against the CPU reference (fp64, 1e-12 relative).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -130,7 +131,12 @@ TEST_F(VulkanFaceChecks, RepeatedCallsOnMeshesOfDifferentSizesReuseBuffersCorrec
     compute::CpuBackend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, cpu);
     ASSERT_EQ(gpu.maps.size(), cpu.maps.size());
     for (Index f = 0; f < mesh.faceCount(); ++f) {
-      ASSERT_LT((gpu.maps[f] - cpu.maps[f]).cwiseAbs().maxCoeff(), 1e-10) << "n " << n << " face " << f;
+      // Relative to the entries, as in VulkanProjectiveFitTest: on the finest grid the 0.01
+      // perturbation is about half a face, and the maps (converted back from face-centred
+      // coordinates) have entries far above 1.
+      const double scale = std::max(1.0, cpu.maps[f].cwiseAbs().maxCoeff());
+      ASSERT_LT((gpu.maps[f] - cpu.maps[f]).cwiseAbs().maxCoeff() / scale, 1e-10)
+          << "n " << n << " face " << f << " largest entry " << scale;
     }
   }
 }

@@ -52,14 +52,38 @@ TEST(LocalFit, RecoversPerspectiveImagesOfQuadsPentagonsAndHexagonsExactly) {
   }
 }
 
+/// Centroid of a corner set.
+Eigen::Vector3d centroid(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& x : points) c += x;
+  return c / static_cast<double>(points.size());
+}
+
+/// The map in coordinates centred at the face centroids, T' = S_p^{-1} T S_q with
+/// (p, 1) S_p = (p - c_p, 1), normalized to T'(3, 3) = 1.
+Eigen::Matrix4d centredMap(const Eigen::Matrix4d& T, const Eigen::Vector3d& cp, const Eigen::Vector3d& cq) {
+  Eigen::Matrix4d SpInverse = Eigen::Matrix4d::Identity();
+  SpInverse.block<1, 3>(3, 0) = cp.transpose();
+  Eigen::Matrix4d Sq = Eigen::Matrix4d::Identity();
+  Sq.block<1, 3>(3, 0) = -cq.transpose();
+  const Eigen::Matrix4d centred = SpInverse * T * Sq;
+  return centred / centred(3, 3);
+}
+
 TEST(LocalFit, PicksTheSolutionClosestToTheIdentityForPlanarQuads) {
   const auto p = tiltedPolygon(4);
   // The identity itself when nothing moves.
   const ProjectiveFit same = fitProjectiveMap(p, p);
   EXPECT_LT((same.map - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
 
-  // Otherwise T - I is orthogonal to the null space, which for a plane with homogeneous
-  // normal m = (n, -n.c) holds the maps m u^T with u_3 = 0: (T - I)[:, j] . m = 0, j < 3.
+  // "Closest to the identity" is measured in coordinates centred at each face's own
+  // centroids (the fit is solved there, which excludes the collapsing solution and makes the
+  // criterion independent of where the face sits), so the test looks at T' = S_p^{-1} T S_q.
+  // There the source plane passes through the origin, its homogeneous normal is m = (n, 0),
+  // and the null space holds the maps m u^T with u_3 = 0: T' - I is orthogonal to it,
+  // (T' - I)[:, j] . m = 0 for j < 3. (Uncentred, the same statement held with
+  // m = (n, -n.c) for the uncentred T; the two minimizers differ, as the Frobenius distance
+  // to the identity is not invariant under translations.)
   const Eigen::Matrix4d H = test::samplePerspective();
   std::vector<Eigen::Vector3d> q;
   for (const auto& x : p) {
@@ -67,12 +91,81 @@ TEST(LocalFit, PicksTheSolutionClosestToTheIdentityForPlanarQuads) {
     q.emplace_back(h.head<3>().transpose() / h[3]);
   }
   const ProjectiveFit fit = fitProjectiveMap(p, q);
+  EXPECT_LT(fit.residual, 1e-12);
+  EXPECT_EQ(fit.map(3, 3), 1.0);
+  const Eigen::Vector3d cp = centroid(p), cq = centroid(q);
   const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
-  const Eigen::Vector4d m(n.x(), n.y(), n.z(), -n.dot(p[0]));
-  const Eigen::Matrix4d D = fit.map - Eigen::Matrix4d::Identity();
+  const Eigen::Vector4d m(n.x(), n.y(), n.z(), 0.0);
+  const Eigen::Matrix4d centred = centredMap(fit.map, cp, cq);
+  const Eigen::Matrix4d D = centred - Eigen::Matrix4d::Identity();
   for (int j = 0; j < 3; ++j) EXPECT_NEAR(D.col(j).dot(m), 0.0, 1e-10) << "column " << j;
-  // And H itself (scaled to H(3,3) = 1) solves the same equations but is farther away.
-  EXPECT_LT((fit.map - Eigen::Matrix4d::Identity()).norm(), (H / H(3, 3) - Eigen::Matrix4d::Identity()).norm());
+  // And H itself solves the same equations but is farther away.
+  EXPECT_LT(D.norm(), (centredMap(H, cp, cq) - Eigen::Matrix4d::Identity()).norm());
+}
+
+TEST(LocalFit, PerturbedPentagonsAndHexagonsDoNotCollapse) {
+  // Five or six corners over-determine a planar homography. Uncentred, the equations had the
+  // exact solution T = n_h r^T on the homogeneous source plane n_h, collapsing the face
+  // (residual ~1e-16, all reciprocal scales ~0). Centred fits must give the least-squares
+  // map instead: scales near 1 (mean reciprocal scale 1 in face-centred coordinates) and a
+  // residual of the order of the perturbation.
+  const Eigen::Matrix4d H = test::samplePerspective();
+  for (int k : {5, 6}) {
+    const auto p = tiltedPolygon(k);
+    for (bool perspective : {false, true}) {
+      std::vector<Eigen::Vector3d> q;
+      for (int i = 0; i < k; ++i) {
+        Eigen::Vector3d x = p[i];
+        if (perspective) {
+          const Eigen::RowVector4d h = hom(x) * H;
+          x = h.head<3>().transpose() / h[3];
+        }
+        // In-plane-ish perturbation of size ~0.01 (the polygon has radius ~0.4).
+        q.push_back(x + 0.01 * Eigen::Vector3d(std::sin(5.0 * i + k), std::cos(3.0 * i), std::sin(7.0 * i + 1.0)));
+      }
+      const ProjectiveFit fit = fitProjectiveMap(p, q);
+      EXPECT_EQ(fit.map(3, 3), 1.0);
+      EXPECT_GT(fit.residual, 1e-5) << k << "-gon";
+      EXPECT_LT(fit.residual, 0.02) << k << "-gon";
+      // Face-centred reciprocal scales: shat'_i = shat_i * (scale of T') with mean 1.
+      const Eigen::Vector3d cp = centroid(p), cq = centroid(q);
+      Eigen::Matrix4d SpInverse = Eigen::Matrix4d::Identity();
+      SpInverse.block<1, 3>(3, 0) = cp.transpose();
+      Eigen::Matrix4d Sq = Eigen::Matrix4d::Identity();
+      Sq.block<1, 3>(3, 0) = -cq.transpose();
+      const double centredScale = (SpInverse * fit.map * Sq)(3, 3);
+      double mean = 0.0;
+      for (int i = 0; i < k; ++i) mean += fit.reciprocalScales[i] / centredScale;
+      EXPECT_NEAR(mean / k, 1.0, 1e-12) << k << "-gon";
+      for (int i = 0; i < k; ++i) {
+        const double s = fit.reciprocalScales[i] / centredScale;
+        EXPECT_GT(s, 0.5) << k << "-gon corner " << i;
+        EXPECT_LT(s, 2.0) << k << "-gon corner " << i;
+        if (!perspective) EXPECT_NEAR(fit.reciprocalScales[i], 1.0, 0.2) << k << "-gon corner " << i;
+      }
+    }
+  }
+}
+
+TEST(LocalFit, FitsDoNotDependOnWhereTheFaceSits) {
+  // Translating source and target conjugates the map; the reciprocal scales change only by
+  // one common factor (the new T(3, 3) normalization).
+  const auto p = tiltedPolygon(6);
+  std::vector<Eigen::Vector3d> q;
+  for (int i = 0; i < 6; ++i) q.push_back(1.1 * p[i] + 0.02 * Eigen::Vector3d(std::cos(2.0 * i), std::sin(i), 0.3));
+  const Eigen::Vector3d a(0.3, -0.1, 0.2), b(-0.2, 0.25, 0.1);
+  std::vector<Eigen::Vector3d> pMoved, qMoved;
+  for (int i = 0; i < 6; ++i) {
+    pMoved.push_back(p[i] + a);
+    qMoved.push_back(q[i] + b);
+  }
+  const ProjectiveFit fit = fitProjectiveMap(p, q);
+  const ProjectiveFit moved = fitProjectiveMap(pMoved, qMoved);
+  EXPECT_NEAR(moved.residual / fit.residual, moved.reciprocalScales[0] / fit.reciprocalScales[0], 1e-10);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(moved.reciprocalScales[i] / moved.reciprocalScales[0],
+                fit.reciprocalScales[i] / fit.reciprocalScales[0], 1e-10);
+  }
 }
 
 TEST(LocalStep, BatchedFitIsExactOnProjectiveImagesOfPolyhedralMeshes) {
