@@ -1,11 +1,11 @@
 #include "subspace/SubspaceTopology.h"
 
 #include <algorithm>
-#include <numeric>
 #include <string>
 #include <unordered_map>
 
 #include "core/Error.h"
+#include "mesh/Topology.h"
 
 namespace plano::subspace {
 namespace {
@@ -50,51 +50,38 @@ std::unordered_map<std::uint64_t, Index> halfEdgeOwners(const FaceList& faces) {
 }  // namespace
 
 SubspaceTopology computeTopology(const FaceList& faces, Index vertexCount) {
-  checkIndices(faces, vertexCount);
-  const auto owner = halfEdgeOwners(faces);
+  // The counts come from the mesh core's MeshTopology; the subspace algorithms additionally
+  // need an oriented manifold, which MeshTopology tolerates (for Validation to describe).
+  const MeshTopology mesh(faces, vertexCount);
+  if (!mesh.inconsistentEdges().empty()) {
+    const Index e = mesh.inconsistentEdges().front();
+    throwBadInput(edgeName(mesh.edgeVertex(e, 0), mesh.edgeVertex(e, 1)) +
+                  " is used twice in the same direction (faces " + std::to_string(mesh.edgeFace(e, 0)) + " and " +
+                  std::to_string(mesh.edgeFace(e, 1)) + "): inconsistently oriented");
+  }
+  for (Index v = 0; v < vertexCount; ++v) {
+    if (mesh.vertexFanCounts()[v] > 1) {
+      throwBadInput("vertex " + std::to_string(v) + " joins " + std::to_string(mesh.vertexFanCounts()[v]) +
+                    " separate face fans (non-manifold vertex)");
+    }
+  }
   SubspaceTopology t;
   t.vertices = vertexCount;
   t.faces = faces.size();
   t.corners = faces.cornerCount();
-
-  // Boundary half-edges have no twin; boundary loops follow them.
-  std::unordered_map<Index, Index> boundaryNext;
-  for (const auto& [k, f] : owner) {
-    const Index a = static_cast<Index>(k >> 32), b = static_cast<Index>(k & 0xffffffffu);
-    if (a < b || !owner.count(key(b, a))) t.edges.push_back({std::min(a, b), std::max(a, b)});
-    if (!owner.count(key(b, a))) {
-      if (!boundaryNext.emplace(a, b).second) {
-        throwBadInput("vertex " + std::to_string(a) + " is on two boundary loops (non-manifold vertex)");
-      }
-    }
+  t.edges.reserve(static_cast<std::size_t>(mesh.edgeCount()));
+  for (Index e = 0; e < mesh.edgeCount(); ++e) {
+    const Index a = mesh.edgeVertex(e, 0), b = mesh.edgeVertex(e, 1);
+    t.edges.push_back({std::min(a, b), std::max(a, b)});
   }
   std::sort(t.edges.begin(), t.edges.end());
-  t.boundaryVertices = static_cast<Index>(boundaryNext.size());
-  std::vector<Index> starts;
-  for (const auto& [a, b] : boundaryNext) starts.push_back(a);
-  std::sort(starts.begin(), starts.end());
-  std::unordered_map<Index, bool> visited;
-  for (Index start : starts) {
-    if (visited[start]) continue;
-    std::vector<Index> loop;
-    Index v = start;
-    do {
-      visited[v] = true;
-      loop.push_back(v);
-      v = boundaryNext.at(v);
-    } while (v != start && loop.size() <= boundaryNext.size());
-    t.boundaryLoops.push_back(std::move(loop));
+  for (Index l = 0; l < mesh.boundaryCount(); ++l) {
+    const auto loop = mesh.boundaryLoop(l);
+    t.boundaryLoops.emplace_back(loop.begin(), loop.end());
   }
-
-  // Connected components (isolated vertices count as components of their own).
-  std::vector<Index> parent(static_cast<std::size_t>(vertexCount));
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](Index x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const auto& e : t.edges) parent[find(e[0])] = find(e[1]);
-  for (Index v = 0; v < vertexCount; ++v) t.components += find(v) == v ? 1 : 0;
+  t.boundaryVertices = mesh.boundaryVertexCount();
+  // Isolated vertices count as components of their own, as in V - E + F = 2c - 2g - b.
+  t.components = mesh.componentCount() + mesh.isolatedVertexCount();
   const Index euler = t.vertices - t.edgeCount() + t.faces;
   t.genus = (2 * t.components - t.boundaryLoopCount() - euler) / 2;
   return t;

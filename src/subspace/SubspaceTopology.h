@@ -1,7 +1,7 @@
 #pragma once
-// Topological counts the subspace algorithms need (edges, boundary loops, genus) and the
-// vertex fans of the polar dual. A private stand-in for mesh/Topology.h (MeshTopology):
-// once that lands, these callers switch to it and this file goes away.
+// Topological counts the subspace algorithms need (edges, boundary loops, genus), taken from
+// the mesh core's MeshTopology and checked for an oriented manifold, and the vertex fans in
+// rotational order that the polar dual needs (MeshTopology keeps fans unordered).
 #include <array>
 #include <vector>
 
