@@ -92,10 +92,7 @@ Info AndersonPlanarizer::solve(Positions& vertices) {
       info.linearResidual = std::max(info.linearResidual, step_->linearResidual());
     }
   }
-  if (converged) info.status = Status::Converged;
-  detail::measureDisplacement(problem, Y, info);
-  vertices = detail::toOriginal(problem, Y);
-  info.seconds = precomputeSeconds_ + secondsSince(start);
+  detail::finishSolve(problem, Y, converged, precomputeSeconds_ + secondsSince(start), info, vertices);
   return info;
 }
 

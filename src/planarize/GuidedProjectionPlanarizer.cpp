@@ -282,10 +282,7 @@ Info GuidedProjectionPlanarizer::solve(Positions& vertices) {
       }
     }
   }
-  if (converged) info.status = Status::Converged;
-  detail::measureDisplacement(problem, Y, info);
-  vertices = detail::toOriginal(problem, Y);
-  info.seconds = precomputeSeconds_ + secondsSince(start);
+  detail::finishSolve(problem, Y, converged, precomputeSeconds_ + secondsSince(start), info, vertices);
   return info;
 }
 

@@ -128,4 +128,12 @@ void measureDisplacement(const Problem& problem, const Positions& normalized, In
   info.meanDisplacement = sum / static_cast<double>(n) * factor;
 }
 
+void finishSolve(const Problem& problem, const Positions& normalized, bool converged, double seconds, Info& info,
+                 Positions& vertices) {
+  if (converged) info.status = Status::Converged;
+  measureDisplacement(problem, normalized, info);
+  vertices = toOriginal(problem, normalized);
+  info.seconds = seconds;
+}
+
 }  // namespace plano::planarize::detail

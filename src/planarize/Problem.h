@@ -50,4 +50,9 @@ Positions toNormalized(const Problem& problem, const Positions& original);
 /// Max and mean vertex displacement from the input, over the input's bounding-box diagonal.
 void measureDisplacement(const Problem& problem, const Positions& normalized, Info& info);
 
+/// The common end of every planarizer's solve: status, displacement, and the normalized
+/// iterate mapped back into `vertices`. `seconds` is the total time spent.
+void finishSolve(const Problem& problem, const Positions& normalized, bool converged, double seconds, Info& info,
+                 Positions& vertices);
+
 }  // namespace plano::planarize::detail

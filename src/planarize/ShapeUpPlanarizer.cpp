@@ -47,10 +47,7 @@ Info ShapeUpPlanarizer::solve(Positions& vertices) {
       break;
     }
   }
-  if (converged) info.status = Status::Converged;
-  detail::measureDisplacement(problem, Y, info);
-  vertices = detail::toOriginal(problem, Y);
-  info.seconds = precomputeSeconds_ + secondsSince(start);
+  detail::finishSolve(problem, Y, converged, precomputeSeconds_ + secondsSince(start), info, vertices);
   return info;
 }
 
