@@ -3,37 +3,16 @@
 // child process (the plano tool), so this process's own Vulkan state is untouched.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <optional>
 #include <string>
 
 #include "compute/Backend.h"
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
+#include "support/ScopedEnvironment.h"
 #include "support/TestMeshes.h"
 
 namespace plano::test {
 namespace {
-
-/// Sets an environment variable for the scope (the child inherits it), then restores it.
-class ScopedEnvironment {
- public:
-  ScopedEnvironment(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnvironment() {
-    if (old_) {
-      ::setenv(name_, old_->c_str(), 1);
-    } else {
-      ::unsetenv(name_);
-    }
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
 
 class VulkanDeviceErrors : public ::testing::Test {
  protected:

@@ -13,6 +13,14 @@ namespace plano::vk {
 Buffer::Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, const char* what)
     : context_(&context), bytes_(std::max<std::size_t>(bytes, 16)), what_(what) {
   VkDevice device = context.device();
+  // Kernels bind whole buffers as storage buffers: a larger one cannot be bound, whatever
+  // vkCreateBuffer says.
+  if (bytes_ > context.info().maxStorageBufferRange) {
+    context_ = nullptr;
+    throwDevice(std::string("Vulkan: a ") + std::to_string(bytes_) + "-byte buffer for " + what_ +
+                " exceeds the device's maxStorageBufferRange of " +
+                std::to_string(context.info().maxStorageBufferRange) + " bytes (try a smaller mesh or the CPU backend)");
+  }
   auto info = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
   info.size = bytes_;
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
@@ -43,6 +51,9 @@ Buffer::Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, con
   allocation.allocationSize = requirements.size;
   try {
     allocation.memoryTypeIndex = context.memoryType(requirements.memoryTypeBits, required, preferred);
+    context.reserveMemory(requirements.size, allocation.memoryTypeIndex, what_);
+    reserved_ = requirements.size;
+    memoryType_ = allocation.memoryTypeIndex;
     const VkResult result = vkAllocateMemory(device, &allocation, nullptr, &memory_);
     if (result != VK_SUCCESS) {
       throwDevice(std::string("Vulkan: allocating ") + std::to_string(bytes_) + " bytes for " + what_ +
@@ -67,6 +78,8 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     mapped_ = std::exchange(other.mapped_, nullptr);
+    reserved_ = std::exchange(other.reserved_, 0);
+    memoryType_ = other.memoryType_;
     bytes_ = std::exchange(other.bytes_, 0);
     what_ = other.what_;
   }
@@ -79,6 +92,8 @@ void Buffer::release() {
   if (mapped_) vkUnmapMemory(device, memory_);
   if (buffer_) vkDestroyBuffer(device, buffer_, nullptr);
   if (memory_) vkFreeMemory(device, memory_, nullptr);
+  if (reserved_ > 0) context_->releaseMemory(reserved_, memoryType_);
+  reserved_ = 0;
   mapped_ = nullptr;
   buffer_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;

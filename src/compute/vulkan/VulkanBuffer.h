@@ -4,6 +4,7 @@
 // (lavapipe, integrated GPUs) they are mapped and written directly, otherwise every
 // upload/download goes through a temporary staging buffer.
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "compute/vulkan/VulkanContext.h"
@@ -19,7 +20,9 @@ class Buffer {
  public:
   Buffer() = default;
   /// A buffer of `bytes` bytes (at least 16, Vulkan forbids empty buffers). `what`
-  /// names its content in error messages. Throws Error(Device) on allocation failure.
+  /// names its content in error messages. Throws Error(Device) on allocation failure and,
+  /// before allocating, when the buffer is larger than the device's maxStorageBufferRange
+  /// or would not fit in its memory heap (or the simulated limit, VulkanFaultSimulation.h).
   Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, const char* what);
   ~Buffer();
   Buffer(Buffer&& other) noexcept;
@@ -45,6 +48,8 @@ class Buffer {
   VkBuffer buffer_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   void* mapped_ = nullptr;
+  VkDeviceSize reserved_ = 0;     ///< Bytes accounted for in the context (Context::reserveMemory).
+  std::uint32_t memoryType_ = 0;  ///< Memory type of the reservation.
   std::size_t bytes_ = 0;
   const char* what_ = "";
 };

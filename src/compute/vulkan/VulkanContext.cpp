@@ -61,6 +61,7 @@ ContextSettings ContextSettings::fromEnvironment(DeviceSelection selection) {
   if (const char* validation = std::getenv("PLANO_VULKAN_VALIDATION")) {
     settings.validation = std::string(validation) == "1";
   }
+  settings.faults = SimulatedFaults::fromEnvironment();
   return settings;
 }
 
@@ -88,7 +89,7 @@ const char* resultName(VkResult result) {
 void Context::check(VkResult result, const char* what) {
   if (result == VK_SUCCESS) return;
   std::string message = std::string("Vulkan: ") + what + " failed: " + resultName(result);
-  if (result == VK_ERROR_DEVICE_LOST) message += " (the device was lost; results of this run are void)";
+  if (result == VK_ERROR_DEVICE_LOST) message += " (device lost: the results of this run are void)";
   if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
     message += " (try a smaller mesh or the CPU backend)";
   }
@@ -207,6 +208,7 @@ void Context::choosePhysicalDevice() {
     Candidate c{i, {}, {}, computeQueueFamily(devices[i])};
     vkGetPhysicalDeviceProperties(devices[i], &c.properties);
     vkGetPhysicalDeviceFeatures(devices[i], &c.features);
+    if (settings_.faults.noFloat64) c.features.shaderFloat64 = VK_FALSE;
     candidates.push_back(c);
   }
   auto describe = [](const Candidate& c) {
@@ -218,7 +220,10 @@ void Context::choosePhysicalDevice() {
       return false;
     }
     if (!c.features.shaderFloat64) {
-      if (why) *why = describe(c) + " lacks shaderFloat64 (Plano's kernels are double precision)";
+      if (why) {
+        *why = describe(c) + " lacks shaderFloat64 (Plano's kernels are double precision)" +
+               (settings_.faults.noFloat64 ? " [simulated by PLANO_VULKAN_SIMULATE_NO_FLOAT64]" : "");
+      }
       return false;
     }
     if (settings_.selection == DeviceSelection::RealGpuOnly &&
@@ -337,6 +342,42 @@ std::uint32_t Context::memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags 
   }
   if (fallback < 0) throwDevice("Vulkan: the device has no memory type with the properties a buffer needs");
   return static_cast<std::uint32_t>(fallback);
+}
+
+void Context::reserveMemory(VkDeviceSize bytes, std::uint32_t memoryType, const char* what) {
+  const std::uint32_t heap = memory_.memoryTypes[memoryType].heapIndex;
+  const VkDeviceSize heapSize = memory_.memoryHeaps[heap].size;
+  std::lock_guard lock(allocationMutex_);
+  const std::string request = "Vulkan: allocating " + std::to_string(bytes) + " bytes for " + what;
+  if (bytes > heapSize || heapUsage_[heap] > heapSize - bytes) {
+    throwDevice(request + " would bring memory heap " + std::to_string(heap) + " to " +
+                std::to_string(heapUsage_[heap] + bytes) + " bytes, over its size of " + std::to_string(heapSize) +
+                " bytes (try a smaller mesh or the CPU backend)");
+  }
+  const std::uint64_t limit = settings_.faults.memoryLimit;
+  if (limit > 0 && (bytes > limit || totalUsage_ > limit - bytes)) {
+    throwDevice(request + " would bring device allocations to " + std::to_string(totalUsage_ + bytes) +
+                " bytes, over the memory limit of " + std::to_string(limit) +
+                " bytes [simulated by PLANO_VULKAN_MEMORY_LIMIT] (try a smaller mesh or the CPU backend)");
+  }
+  heapUsage_[heap] += bytes;
+  totalUsage_ += bytes;
+}
+
+void Context::releaseMemory(VkDeviceSize bytes, std::uint32_t memoryType) {
+  const std::uint32_t heap = memory_.memoryTypes[memoryType].heapIndex;
+  std::lock_guard lock(allocationMutex_);
+  heapUsage_[heap] -= std::min(bytes, heapUsage_[heap]);
+  totalUsage_ -= std::min(bytes, totalUsage_);
+}
+
+VkResult Context::submissionResult(VkResult result) {
+  std::lock_guard lock(allocationMutex_);
+  ++submissions_;
+  const std::uint64_t lostAt = settings_.faults.deviceLostAtSubmit;
+  // A lost device stays lost, as a real one does.
+  if (lostAt > 0 && submissions_ >= lostAt) return VK_ERROR_DEVICE_LOST;
+  return result;
 }
 
 std::vector<std::string> Context::validationMessages() const {

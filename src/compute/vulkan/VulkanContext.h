@@ -5,10 +5,13 @@
 // (or two tests) never share device state.
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include "compute/vulkan/VulkanFaultSimulation.h"
 
 namespace plano::vk {
 
@@ -32,8 +35,10 @@ struct ContextSettings {
   /// Cap on the workgroups of one dispatch dimension (0: the device's limit). Tests lower
   /// it to exercise the kernels' grid-stride loops on small inputs.
   std::uint32_t maxWorkGroups = 0;
+  /// Test-only fault injection (VulkanFaultSimulation.h); fromEnvironment() reads it.
+  SimulatedFaults faults;
 
-  /// Settings with deviceOverride and validation read from the environment.
+  /// Settings with deviceOverride, validation and faults read from the environment.
   static ContextSettings fromEnvironment(DeviceSelection selection);
 };
 
@@ -75,6 +80,16 @@ class Context {
   std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                            VkMemoryPropertyFlags preferred) const;
 
+  /// Account for a device allocation of `bytes` in memory type `memoryType` before it is
+  /// made. Throws Error(Device) naming the sizes when it would take the allocations in that
+  /// type's heap over the heap size, or all allocations over the simulated memory limit.
+  void reserveMemory(VkDeviceSize bytes, std::uint32_t memoryType, const char* what);
+  /// Give back what reserveMemory accounted for (the allocation was freed).
+  void releaseMemory(VkDeviceSize bytes, std::uint32_t memoryType);
+  /// What a queue submission reports to its caller: `result`, except VK_ERROR_DEVICE_LOST
+  /// from the simulated lost submission on (SimulatedFaults::deviceLostAtSubmit).
+  VkResult submissionResult(VkResult result);
+
   /// Validation messages (warnings and errors) received so far; always empty when
   /// validation is off.
   std::vector<std::string> validationMessages() const;
@@ -102,6 +117,11 @@ class Context {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool commandPool_ = VK_NULL_HANDLE;
+
+  std::mutex allocationMutex_;
+  std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS> heapUsage_{};  ///< Bytes allocated per heap.
+  VkDeviceSize totalUsage_ = 0;
+  std::uint64_t submissions_ = 0;
 
   mutable std::mutex messagesMutex_;
   std::vector<std::string> messages_;

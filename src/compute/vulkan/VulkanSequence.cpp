@@ -104,7 +104,9 @@ void Sequence::run() {
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &commands_;
   Context::check(vkQueueSubmit(context_.queue(), 1, &submit, fence_), "submitting work to the compute queue");
-  Context::check(vkWaitForFences(device, 1, &fence_, VK_TRUE, UINT64_MAX), "waiting for the compute queue");
+  // Waited for even when a loss is simulated, so that no resource is freed while in use.
+  const VkResult waited = vkWaitForFences(device, 1, &fence_, VK_TRUE, UINT64_MAX);
+  Context::check(context_.submissionResult(waited), "waiting for the compute queue");
   ran_ = true;
 }
 
