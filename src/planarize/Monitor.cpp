@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::planarize::detail {
@@ -14,6 +15,8 @@ Monitor::Monitor(const Problem& problem, compute::Backend& backend, double toler
 }
 
 bool Monitor::record(const Positions& normalized, Info& info) {
+  // Every planarization method records once per iteration: the one place to poll.
+  throwIfCancelled("planarization");
   mesh_.vertices = normalized;
   backend_->facePlanarity(mesh_, values_);
   double maxValue = 0.0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "projective/ConstrainedVertices.h"
 #include "projective/LocalStep.h"
@@ -72,6 +73,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     FaceMaps maps;
     // Phase 1 (§6.1): fit, closest rigid/similar map, global step.
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
+      throwIfCancelled("deformation");
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const Positions normalized = space_.normalization().toNormalized(positions);
       const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy, &normalized);
@@ -85,6 +87,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     // constraints, until the faces are planar again.
     bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
     for (int k = 0; k < settings_.maxProjectionIterations && !planar; ++k) {
+      throwIfCancelled("deformation (projection)");
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
       const Positions next = space_.positions(maps.maps);

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::projective {
@@ -154,6 +155,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   Eigen::MatrixXd x = T;
   bool solved = false;
   for (double eps : schedule) {
+    throwIfCancelled("the global step");
     Eigen::MatrixXd lower = d;
     Eigen::MatrixXd upper = d;
     for (Eigen::Index r = 0; r < m; ++r) {

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "projective/Deformation.h"
 #include "projective/LocalStep.h"
@@ -157,6 +158,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     bool converged = false;
     const double coarseDiagonal = coarseSpace.normalization().scale;
     for (int it = 0; it < settings.maxCoarseIterations && !converged; ++it) {
+      throwIfCancelled("multi-resolution deformation");
       const LocalStepResult fit = fitFaceMaps(backend, coarseSpace, current);
       const auto ideal = closestIdealMaps(backend, coarseSpace, fit.fits.maps, settings.energy);
       const GlobalStepInfo step = coarseStep.solve(ideal, coarseMaps);

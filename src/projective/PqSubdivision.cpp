@@ -3,6 +3,7 @@
 #include <chrono>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "projective/LocalStep.h"
 #include "projective/ShapeSpace.h"
@@ -43,6 +44,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
   FaceMaps maps;
   PolygonMesh current{targets, refined.faces};
   for (int iteration = 0; iteration < settings.maxIterationsPerLevel; ++iteration) {
+    throwIfCancelled("subdivision");
     const LocalStepResult local = fitFaceMaps(backend, space, target);
     const GlobalStepInfo step = global.solve(local.fits.maps, Positions(), maps);
     current.vertices = space.positions(maps.maps);

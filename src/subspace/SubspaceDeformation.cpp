@@ -3,6 +3,7 @@
 #include <limits>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::subspace {
@@ -103,6 +104,7 @@ SubspaceDeformationInfo SubspaceDeformer::solve(Positions& X, const std::functio
   const Eigen::VectorXd fixedPart = reduced_ * W0;
   double previous = std::numeric_limits<double>::infinity();
   for (Index k = 0; k < settings_.maxIterations; ++k) {
+    throwIfCancelled("subspace deformation");
     const double energy = localStep(X);
     info.energy = energy;
     if (k > 0 && previous - energy <= settings_.tolerance * std::max(previous, 1e-300)) {

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SVD>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "mesh/Planarity.h"
 #include "projective/LocalFit.h"
@@ -24,6 +25,9 @@ class CholmodSpdSolver final : public SpdSolver {
   }
 
   LinearSolveInfo solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override {
+    // Every ADMM iteration (BoxQp) and most solver iterations make a solve here: polling
+    // here makes them interruptible without touching each loop.
+    throwIfCancelled("a linear solve");
     X = factor_.solve(B);
     LinearSolveInfo info;
     info.iterations = 1;
