@@ -24,9 +24,30 @@ nlohmann::json baseReport(const std::string& command, const std::string& backend
           {"seconds", seconds}};
 }
 
+namespace {
+std::size_t written = 0;
+}  // namespace
+
+const char* failureStatus(ErrorKind kind) {
+  switch (kind) {
+    case ErrorKind::Usage: return "usage_error";
+    case ErrorKind::BadInput: return "bad_input";
+    case ErrorKind::Numerical: return "numerical_failure";
+    case ErrorKind::Device: return "device_failure";
+  }
+  return "error";
+}
+
 void writeReport(const std::string& path, const nlohmann::json& report) {
   if (path.empty()) return;
   writeFileAtomically(path, report.dump(2) + "\n");
+  ++written;
+}
+
+std::size_t reportsWritten() { return written; }
+
+nlohmann::json failureReport(const std::string& command, const std::string& status, const std::string& reason) {
+  return {{"command", command}, {"status", status}, {"reason", reason}, {"output_written", false}};
 }
 
 }  // namespace plano::cli

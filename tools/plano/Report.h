@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/Error.h"
 #include "mesh/Planarity.h"
 #include "mesh/PolygonMesh.h"
 
@@ -18,5 +19,18 @@ nlohmann::json baseReport(const std::string& command, const std::string& backend
 
 /// Write a report atomically (pretty-printed); no-op for an empty path.
 void writeReport(const std::string& path, const nlohmann::json& report);
+
+/// How many reports writeReport has written in this process. A run that wrote its own
+/// report (more detailed than the failure report) changes it, so the failure report does
+/// not replace that one.
+std::size_t reportsWritten();
+
+/// The report of a run that ended before writing its own: command, status
+/// ("interrupted", "numerical_failure", "device_failure", "bad_input"), reason (the
+/// message) and output_written false.
+nlohmann::json failureReport(const std::string& command, const std::string& status, const std::string& reason);
+
+/// The status word of a failure report for an error of this kind.
+const char* failureStatus(ErrorKind kind);
 
 }  // namespace plano::cli

@@ -5,6 +5,7 @@
 
 #include "core/Error.h"
 #include "plano/Command.h"
+#include "plano/RunCommand.h"
 
 namespace plano::cli {
 
@@ -28,6 +29,8 @@ void progress(const GlobalOptions& options, const std::string& message) {
 
 int main(int argc, char** argv) {
   using namespace plano::cli;
+  // First, so that a signal arriving at any time after start-up stops the run cleanly.
+  installInterruptHandlers();
   CLI::App app{"plano: modelling polyhedral meshes (planar faces) with projective maps and linear spaces"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "plano 0.1.0");
@@ -56,12 +59,13 @@ int main(int argc, char** argv) {
 
   try {
     for (auto& [sub, run] : commands) {
-      if (sub->parsed()) return run(options);
+      if (!sub->parsed()) continue;
+      CommandRun command{sub->get_name(), run, {}};
+      const CLI::Option* report = sub->get_option_no_throw("--report");
+      if (report != nullptr && report->count() > 0) command.reportPath = report->as<std::string>();
+      return runCommand(command, options, std::cerr);
     }
     return plano::exitCode(plano::ErrorKind::Usage);
-  } catch (const plano::Error& e) {
-    std::cerr << "plano: " << plano::toString(e.kind()) << ": " << e.what() << std::endl;
-    return plano::exitCode(e.kind());
   } catch (const std::bad_alloc&) {
     std::cerr << "plano: out of memory" << std::endl;
     return plano::exitCode(plano::ErrorKind::Numerical);
