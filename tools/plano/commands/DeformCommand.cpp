@@ -13,6 +13,7 @@
 #include "mesh/Constraints.h"
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "plano/commands/SubspaceDeform.h"
 #include "projective/Deformation.h"
@@ -253,7 +254,7 @@ RunFunction setup(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--report", options->report, "Write a JSON report to this file");
-  app.add_flag("--keep-partial", options->keepPartial, "Write the last iterate even when the deformation fails");
+  addKeepPartialFlag(app, options->keepPartial);
   app.add_flag("--in-place", options->inPlace, "Allow the output to overwrite the input mesh");
   // Multi-resolution editing (paper §6).
   app.add_flag("--multires", options->multires,
@@ -286,6 +287,7 @@ RunFunction setup(CLI::App& app) {
       request.output = options->output;
       request.report = options->report;
       request.inPlace = options->inPlace;
+      request.keepPartial = options->keepPartial;
       if (options->maxIterationsOption->count() > 0) request.maxIterations = options->maxIterations;
       if (options->toleranceOption->count() > 0) request.tolerance = options->tolerance;
       return runSubspaceDeform(request, global);
@@ -307,15 +309,8 @@ RunFunction setup(CLI::App& app) {
     nlohmann::json report = baseReport("deform", backend->name(), outcome.mesh, stats, seconds);
     report["iterations"] = outcome.iterations;
     report.update(outcome.details);
-    const bool write = outcome.succeeded || options->keepPartial;
-    report["output_written"] = write;
-    if (write) writeMesh(options->output, outcome.mesh);
-    writeReport(options->report, report);
-    if (!outcome.succeeded) {
-      throwNumerical("deform: " + outcome.message +
-                     (options->keepPartial ? "; partial result written to " + options->output
-                                           : "; no output written (use --keep-partial to write the last iterate)"));
-    }
+    CommandOutcome result{report["status"].get<std::string>(), outcome.succeeded ? "" : outcome.message};
+    finishCommand("deform", result, options->keepPartial, {{options->output, &outcome.mesh}}, report, options->report);
     progress(global, "deformed in " + std::to_string(outcome.iterations) + " iterations, max planarity " +
                          std::to_string(stats.max) + "% -> " + options->output);
     return 0;

@@ -8,6 +8,7 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "subspace/Eigenshapes.h"
 #include "subspace/LinearSpace.h"
@@ -24,6 +25,7 @@ struct DualOptions {
   std::string space = "parallel";
   Index eigenshape = 3;
   double amplitude = 0.05;
+  bool keepPartial = false;
 };
 
 RunFunction setup(CLI::App& app) {
@@ -39,16 +41,17 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--amplitude", o->amplitude, "Peak displacement of the dual, relative to its bounding-box diagonal")
       ->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);
-    writeMesh(o->output, dual);
     progress(global, "dual: " + std::to_string(dual.vertexCount()) + " vertices, " + std::to_string(dual.faceCount()) +
                          " faces -> " + o->output);
     nlohmann::json j;
     PlanarityStats stats = planarityStats(dual);
     nlohmann::json exploration;
+    PolygonMesh primal = mesh;
     if (!o->primal.empty()) {
       const LinearSpace space = buildLinearSpace(dual, uniformAssignment(parseSpaceKind(o->space), dual.faceCount()));
       EigenshapeSettings es;
@@ -60,9 +63,7 @@ RunFunction setup(CLI::App& app) {
       }
       const Positions edited = bandPass(space.N, shapes, space.N.project(dual.vertices), o->eigenshape,
                                         o->eigenshape + 1, o->amplitude);
-      PolygonMesh primal = mesh;
       primal.vertices = primalFromDual(mesh.faces, edited, mesh.vertices);
-      writeMesh(o->primal, primal);
       stats = planarityStats(primal);
       exploration = {{"space", o->space},
                      {"dimension", space.dof.dimension},
@@ -79,9 +80,11 @@ RunFunction setup(CLI::App& app) {
     j["dual_faces"] = dual.faceCount();
     j["dual_max_planarity"] = planarityStats(dual).max;
     if (!exploration.is_null()) j["exploration"] = exploration;
+    std::vector<MeshOutput> outputs{{o->output, &dual}};
+    if (!o->primal.empty()) outputs.push_back({o->primal, &primal});
+    finishCommand("dual", CommandOutcome{}, o->keepPartial, outputs, j, o->report);
     std::cout << "dual of " << o->input << ": " << dual.vertexCount() << " vertices, " << dual.faceCount()
               << " faces -> " << o->output << "\n";
-    writeReport(o->report, j);
     return 0;
   };
 }

@@ -7,6 +7,7 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "subspace/AffineLifting.h"
 #include "subspace/TutteEmbedding.h"
@@ -22,6 +23,7 @@ struct EmbedOptions {
   double height = 0.25;
   Index eigenshape = 0;
   Index vertex = -1;
+  bool keepPartial = false;
 };
 
 RunFunction setup(CLI::App& app) {
@@ -35,6 +37,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--eigenshape", o->eigenshape, "Which non-planar lifting eigenshape (0 = lowest)")->capture_default_str();
   app.add_option("--vertex", o->vertex, "Handle vertex (default: the one nearest the centre)");
   app.add_option("--report", o->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh topology = readMesh(o->input);
@@ -51,7 +54,6 @@ RunFunction setup(CLI::App& app) {
       settings.handleVertex = o->vertex;
       out = liftWithAffineSpace(out, settings, &lift);
     }
-    writeMesh(o->output, out);
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json j = baseReport("embed", "cpu", out, stats, seconds);
@@ -60,9 +62,9 @@ RunFunction setup(CLI::App& app) {
     j["lift"] = o->lift;
     j["liftings"] = lift.liftings;
     j["max_height"] = lift.maxHeight;
+    finishCommand("embed", CommandOutcome{}, o->keepPartial, {{o->output, &out}}, j, o->report);
     std::cout << "embedded " << o->input << " (" << tutte.flippedFaces << " flipped faces), lift " << o->lift
               << ", max height " << lift.maxHeight << ", max planarity " << stats.max << "% -> " << o->output << "\n";
-    writeReport(o->report, j);
     return 0;
   };
 }

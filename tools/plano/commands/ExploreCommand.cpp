@@ -7,6 +7,7 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "subspace/Eigenshapes.h"
 #include "subspace/FaceAssignmentIO.h"
@@ -26,6 +27,7 @@ struct ExploreOptions {
   Index eigenshapes = 10;
   std::string band;
   double amplitude = 0.05;
+  bool keepPartial = false;
 };
 
 std::pair<Index, Index> parseBand(const std::string& text, Index count) {
@@ -55,6 +57,7 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("-o,--output", o->output, "Output mesh")->required();
   app.add_option("--report", o->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
@@ -70,7 +73,6 @@ RunFunction setup(CLI::App& app) {
     const auto [lo, hi] = parseBand(o->band, shapes.count());
     PolygonMesh out = mesh;
     out.vertices = bandPass(space.N, shapes, space.N.project(mesh.vertices), lo, hi, o->amplitude);
-    writeMesh(o->output, out);
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json j = baseReport("explore", "cpu", out, stats, seconds);
@@ -82,10 +84,10 @@ RunFunction setup(CLI::App& app) {
     j["amplitude"] = o->amplitude;
     j["eigensolver"] = info.dense ? "dense" : "spectra";
     j["subspace_residual"] = space.B.residual(out.vertices) / out.vertices.norm();
+    finishCommand("explore", CommandOutcome{}, o->keepPartial, {{o->output, &out}}, j, o->report);
     std::cout << "added eigenshapes " << lo << ":" << hi << " of " << shapes.count() << " (" << o->space
               << " space, dimension " << space.dof.dimension << "), max planarity " << stats.max << "% -> "
               << o->output << "\n";
-    writeReport(o->report, j);
     return 0;
   };
 }

@@ -6,6 +6,7 @@
 #include "core/Error.h"
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "projective/Interpolation.h"
 
@@ -18,6 +19,7 @@ struct InterpolateOptions {
   double t = 0.5;
   std::string output;
   std::string report;
+  bool keepPartial = false;
 };
 
 RunFunction setup(CLI::App& app) {
@@ -29,6 +31,7 @@ RunFunction setup(CLI::App& app) {
       ->check(CLI::Range(-1e6, 1e6));
   app.add_option("-o,--output", options->output, "Output mesh file")->required();
   app.add_option("--report", options->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, options->keepPartial);
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh a = readMesh(options->first);
@@ -38,7 +41,6 @@ RunFunction setup(CLI::App& app) {
     projective::GlobalStepInfo info;
     const PolygonMesh result = interpolation.at(options->t, &info);
     const PlanarityStats stats = planarityStats(result);
-    writeMesh(options->output, result);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json report = baseReport("interpolate", backend->name(), result, stats, seconds);
     report["t"] = options->t;
@@ -46,8 +48,8 @@ RunFunction setup(CLI::App& app) {
     report["epsilon"] = info.epsilon;
     report["initial_violation"] = info.initialViolation;
     report["constraint_residual"] = info.constraintResidual;
-    report["status"] = projective::toString(info.status);
-    writeReport(options->report, report);
+    finishCommand("interpolate", CommandOutcome{projective::toString(info.status), ""}, options->keepPartial,
+                  {{options->output, &result}}, report, options->report);
     std::ostringstream line;
     line << "interpolated at t = " << options->t << ", eps " << info.epsilon << ", max planarity " << stats.max
          << "% -> " << options->output;

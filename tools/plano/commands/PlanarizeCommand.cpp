@@ -13,6 +13,7 @@
 #include "mesh/Planarity.h"
 #include "planarize/Planarize.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 
 namespace plano::cli {
@@ -76,7 +77,7 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
   app.add_option("--report", options->report, "Write a JSON report to this file");
-  app.add_flag("--keep-partial", options->keepPartial, "Write the mesh even when the tolerance was not reached");
+  addKeepPartialFlag(app, options->keepPartial);
   app.add_flag("--in-place", options->inPlace, "Allow the output to be the input file");
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
@@ -109,14 +110,14 @@ RunFunction setup(CLI::App& app) {
                          " iterations, max planarity " + std::to_string(info.maxPlanarity.front()) + "% -> " +
                          std::to_string(info.maxPlanarity.back()) + "%, max displacement " +
                          std::to_string(100.0 * info.maxDisplacement) + "% of the bounding-box diagonal");
-    if (reached || options->keepPartial) writeMesh(options->output, mesh);
-    writeReport(options->report, reportJson(*options, settings, info, mesh, backend->name(), seconds));
+    CommandOutcome outcome{planarize::toString(info.status), ""};
     if (!reached) {
-      throwNumerical("planarize: max planarity " + std::to_string(info.maxPlanarity.back()) + "% is above the tolerance " +
-                     std::to_string(settings.tolerance) + "% after " + std::to_string(info.iterations) +
-                     " iterations (" + planarize::toString(info.status) + ")" +
-                     (options->keepPartial ? "; partial result written" : "; no output written (--keep-partial keeps it)"));
+      outcome.failure = "max planarity " + std::to_string(info.maxPlanarity.back()) + "% is above the tolerance " +
+                        std::to_string(settings.tolerance) + "% after " + std::to_string(info.iterations) +
+                        " iterations (" + planarize::toString(info.status) + ")";
     }
+    finishCommand("planarize", outcome, options->keepPartial, {{options->output, &mesh}},
+                  reportJson(*options, settings, info, mesh, backend->name(), seconds), options->report);
     return 0;
   };
 }

@@ -9,6 +9,7 @@
 #include "mesh/Constraints.h"
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "projective/MapPrescription.h"
 #include "projective/UniformScaling.h"
@@ -30,6 +31,7 @@ struct PrescribeOptions {
   std::string constraints;
   std::string report;
   bool inPlace = false;
+  bool keepPartial = false;
 };
 
 nlohmann::json stepJson(const projective::GlobalStepInfo& info) {
@@ -63,6 +65,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--constraints", options->constraints, "JSON constraints file: fixed vertices and handles");
   app.add_option("--report", options->report, "Write a JSON report to this file");
   app.add_flag("--in-place", options->inPlace, "Allow the output to overwrite the input mesh");
+  addKeepPartialFlag(app, options->keepPartial);
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     std::error_code ec;
@@ -111,7 +114,6 @@ RunFunction setup(CLI::App& app) {
       for (const auto& step : r.projection) steps.push_back(stepJson(step));
     }
     const PlanarityStats stats = planarityStats(result);
-    writeMesh(options->output, result);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json report = baseReport("prescribe", backend->name(), result, stats, seconds);
     report["map"] = options->map;
@@ -121,7 +123,9 @@ RunFunction setup(CLI::App& app) {
     nlohmann::json epsilons = nlohmann::json::array();
     for (const auto& s : steps) epsilons.push_back(s["epsilon"]);
     report["epsilon"] = epsilons;
-    writeReport(options->report, report);
+    // Failures of the global steps (no feasible eps within the schedule) throw Error(Numerical).
+    finishCommand("prescribe", CommandOutcome{"solved", ""}, options->keepPartial, {{options->output, &result}}, report,
+                  options->report);
     std::ostringstream line;
     line << "prescribed " << options->map << " on " << (options->faces.empty() ? mesh.faceCount() : options->faces.size())
          << " faces, " << steps.size() << " global steps, max planarity " << stats.max << "% -> " << options->output;

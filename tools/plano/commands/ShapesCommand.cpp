@@ -7,6 +7,7 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "subspace/FaceAssignmentIO.h"
 #include "subspace/FundamentalShapes.h"
@@ -31,6 +32,7 @@ struct ShapesOptions {
   double amplitude = 0.05;
   double smoothness = 1.0;
   Index maxSupport = 64;
+  bool keepPartial = false;
 };
 
 RunFunction setup(CLI::App& app) {
@@ -51,6 +53,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--max-support", o->maxSupport, "Sparse shape: most vertices that may move")->capture_default_str();
   app.add_option("-o,--output", o->output, "Output mesh")->required();
   app.add_option("--report", o->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions&) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
@@ -94,7 +97,6 @@ RunFunction setup(CLI::App& app) {
     const double peak = shape.rowwise().norm().maxCoeff();
     PolygonMesh out = mesh;
     out.vertices = base + (peak > 0.0 ? o->amplitude * boundingBoxDiagonal(mesh.vertices) / peak : 0.0) * shape;
-    writeMesh(o->output, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json j = baseReport("shapes", "cpu", out, planarityStats(out), seconds);
     j["space"] = o->space;
@@ -102,7 +104,7 @@ RunFunction setup(CLI::App& app) {
     j["vertex"] = o->vertex;
     j["direction"] = {direction[0], direction[1], direction[2]};
     j["shape"] = extra;
-    writeReport(o->report, j);
+    finishCommand("shapes", CommandOutcome{}, o->keepPartial, {{o->output, &out}}, j, o->report);
     return 0;
   };
 }

@@ -1,5 +1,5 @@
 // plano subdivide MESH (-o OUT | --in-place) --scheme catmull-clark|four-point --levels K
-//   [--tolerance PERCENT] [--max-iterations N] [--linear] [--report R.json]
+//   [--tolerance PERCENT] [--max-iterations N] [--linear] [--report R.json] [--keep-partial]
 // Planar-quad subdivision (projective-maps paper, §5).
 #include <iomanip>
 #include <sstream>
@@ -7,6 +7,7 @@
 #include "core/Error.h"
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 #include "projective/PqSubdivision.h"
 
@@ -23,6 +24,7 @@ struct SubdivideOptions {
   int maxIterations = 20;
   bool linear = false;
   std::string report;
+  bool keepPartial = false;
 };
 
 nlohmann::json levelJson(const projective::PqLevelInfo& level) {
@@ -69,6 +71,7 @@ RunFunction setup(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   app.add_flag("--linear", options->linear, "Only the linear scheme, without planarization");
   app.add_option("--report", options->report, "Write a JSON report to this file");
+  addKeepPartialFlag(app, options->keepPartial);
 
   return [options](const GlobalOptions& global) {
     if (options->output.empty() && !options->inPlace) throwUsage("subdivide: give -o OUT or --in-place");
@@ -86,7 +89,6 @@ RunFunction setup(CLI::App& app) {
     const projective::PqSubdivisionResult result = projective::subdividePlanarQuads(*backend, input, settings);
     const projective::PqSubdivisionInfo& info = result.info;
     const PolygonMesh mesh = result.finestMesh();
-    writeMesh(target, mesh);
 
     for (const auto& level : info.levels) {
       std::ostringstream line;
@@ -98,18 +100,18 @@ RunFunction setup(CLI::App& app) {
     const PlanarityStats stats = planarityStats(mesh, settings.planarityTolerance);
     nlohmann::json report = baseReport("subdivide", backend->name(), mesh, stats, info.seconds);
     report["scheme"] = options->scheme;
-    report["status"] = projective::toString(info.status);
     report["iterations"] = info.totalIterations;
     nlohmann::json levels = nlohmann::json::array();
     for (const auto& level : info.levels) levels.push_back(levelJson(level));
     report["levels"] = levels;
-    writeReport(options->report, report);
-
+    CommandOutcome outcome{projective::toString(info.status), ""};
     if (info.status == projective::PqSubdivisionStatus::IterationLimit) {
-      throwNumerical("subdivide: some level did not reach " + std::to_string(settings.planarityTolerance) +
-                     "% max planarity in " + std::to_string(settings.maxIterationsPerLevel) +
-                     " iterations; the result was written to " + target + " anyway");
+      std::ostringstream failure;
+      failure << "some level did not reach " << settings.planarityTolerance << "% max planarity in "
+              << settings.maxIterationsPerLevel << " iterations";
+      outcome.failure = failure.str();
     }
+    finishCommand("subdivide", outcome, options->keepPartial, {{target, &mesh}}, report, options->report);
     return 0;
   };
 }

@@ -63,6 +63,7 @@ RunFunction setup(CLI::App& app) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     nlohmann::json j = baseReport("subspace", "cpu", mesh, planarityStats(mesh), seconds);
+    j["status"] = "ok";  // failures (rank, basis) end in Error(Numerical) and main's failure report
     j["space"] = o->space;
     j["dimension"] = space.dof.dimension;
     j["lower_bound"] = space.dof.lowerBound;

@@ -7,6 +7,7 @@
 #include "mesh/Constraints.h"
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
+#include "plano/CommandOutcome.h"
 #include "plano/OutputGuard.h"
 #include "plano/Report.h"
 #include "subspace/FaceAssignmentIO.h"
@@ -36,7 +37,6 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   Positions X = space.N.project(mesh.vertices);
   const SubspaceDeformationInfo info = deformer.solve(X);
   PolygonMesh out{X, mesh.faces};
-  writeMesh(request.output, out);
   const PlanarityStats stats = planarityStats(out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json j = baseReport("deform", backend->name(), out, stats, seconds);
@@ -45,15 +45,20 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   j["dimension"] = space.dof.dimension;
   j["free_dimension"] = deformer.freeDimension();
   j["iterations"] = info.iterations;
-  j["status"] = info.status == DeformationStatus::Converged ? "converged" : "iteration_limit";
   j["energy_value"] = info.energy;
   j["constraint_residual"] = info.constraintResidual;
   j["max_handle_distance"] = info.maxHandleDistance;
   j["max_subspace_residual"] = info.maxSubspaceResidual;
+  const bool converged = info.status == DeformationStatus::Converged;
+  CommandOutcome outcome{converged ? "converged" : "iteration_limit", ""};
+  if (!converged) {
+    outcome.failure = "the energy did not settle within the cap of " + std::to_string(request.maxIterations) +
+                      " iterations";
+  }
+  finishCommand("deform", outcome, request.keepPartial, {{request.output, &out}}, j, request.report);
   std::cout << "deformed in the " << request.space << " space (dimension " << space.dof.dimension << ") in "
             << info.iterations << " iterations, handle distance " << info.maxHandleDistance << ", max planarity "
             << stats.max << "% -> " << request.output << "\n";
-  writeReport(request.report, j);
   return 0;
 }
 

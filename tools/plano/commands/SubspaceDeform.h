@@ -17,12 +17,14 @@ struct SubspaceDeformRequest {
   std::string output;            ///< Output mesh.
   std::string report;            ///< JSON report path (optional).
   bool inPlace = false;          ///< Allow the output to overwrite the input mesh.
+  bool keepPartial = false;      ///< Write the last iterate even when the iteration cap was hit.
   int maxIterations = 100;
   double tolerance = 1e-8;       ///< Relative energy decrease that stops the iteration.
 };
 
 /// Run the deformation and write the output (and report). Returns the exit code; throws
-/// plano::Error for bad input (mesh, constraints, space) or a numerical failure.
+/// plano::Error for bad input (mesh, constraints, space) or a numerical failure (the
+/// iteration cap reached before the energy settled, a failed factorization, NaN).
 int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions& global);
 
 }  // namespace plano::cli

@@ -1,0 +1,51 @@
+#include "plano/CommandOutcome.h"
+
+#include "core/Cancellation.h"
+#include "core/Error.h"
+#include "mesh/MeshIO.h"
+#include "plano/Report.h"
+
+namespace plano::cli {
+
+void addKeepPartialFlag(CLI::App& app, bool& keepPartial) {
+  app.add_flag("--keep-partial", keepPartial,
+               "Write the result even when the computation failed (exit code 4 all the same); an interrupted run "
+               "never writes it");
+}
+
+void finishCommand(const std::string& command, CommandOutcome outcome, bool keepPartial,
+                   const std::vector<MeshOutput>& outputs, nlohmann::json report, const std::string& reportPath) {
+  // A signal that arrived after the last solver iteration still means "do not write".
+  throwIfCancelled("writing the results");
+  bool finite = true;
+  for (const MeshOutput& output : outputs) {
+    if (output.mesh->vertices.allFinite()) continue;
+    finite = false;
+    if (outcome.failure.empty()) {
+      outcome.status = "non_finite";
+      outcome.failure = "the result has non-finite vertex coordinates (" + output.path + ")";
+    }
+  }
+  const bool succeeded = outcome.failure.empty();
+  // Non-finite coordinates cannot be written to any mesh format, partial or not.
+  const bool write = (succeeded || keepPartial) && finite;
+  if (write) {
+    for (const MeshOutput& output : outputs) writeMesh(output.path, *output.mesh);
+  }
+  report["status"] = outcome.status;
+  if (!succeeded) report["reason"] = outcome.failure;
+  report["output_written"] = write;
+  writeReport(reportPath, report);
+  if (succeeded) return;
+  std::string written;
+  if (write) {
+    for (const MeshOutput& output : outputs) written += (written.empty() ? "" : ", ") + output.path;
+    written = "; partial result written to " + written;
+  } else {
+    written = keepPartial ? "; no output written (nothing finite to keep)"
+                          : "; no output written (--keep-partial writes the partial result)";
+  }
+  throwNumerical(command + ": " + outcome.failure + written);
+}
+
+}  // namespace plano::cli
