@@ -89,3 +89,19 @@ TEST_F(NumericalFailureCommand, SubspaceDeformationAtItsIterationCap) {
 
 }  // namespace
 }  // namespace plano::test
+
+namespace plano::test {
+namespace {
+
+TEST(NumericalFailureOptions, EveryComputingCommandAcceptsReportAndKeepPartial) {
+  for (const char* command :
+       {"deform", "planarize", "subdivide", "prescribe", "interpolate", "explore", "shapes", "dual", "embed"}) {
+    const ToolResult help = runTool(std::string(command) + " --help");
+    EXPECT_EQ(help.exitCode, 0) << command;
+    EXPECT_NE(help.out.find("--report"), std::string::npos) << command << ":\n" << help.out;
+    EXPECT_NE(help.out.find("--keep-partial"), std::string::npos) << command << ":\n" << help.out;
+  }
+}
+
+}  // namespace
+}  // namespace plano::test
