@@ -1,6 +1,7 @@
 // Batched local-step kernels per backend: projective fits of every face (projective-maps
 // paper §4.1) and closest rotations (App. A), on generated quad meshes of ~4k to 1M faces.
 // Vulkan times include uploads and read-backs (the Backend interface's cost).
+#include "MemoryCounters.h"
 #include "VulkanBenchSupport.h"
 
 namespace {
@@ -10,6 +11,7 @@ using plano::compute::BackendChoice;
 void BM_ProjectiveFits(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::Positions target = plano::bench::jittered(mesh.vertices, 0.1 / std::sqrt(double(state.range(0))));
   plano::compute::ProjectiveFits fits;
@@ -24,6 +26,7 @@ void BM_ProjectiveFits(benchmark::State& state, BackendChoice choice) {
 void BM_ClosestRotations(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const auto count = static_cast<std::size_t>(state.range(0));  // one 3x3 matrix per face
   std::mt19937 rng(1);
   std::normal_distribution<double> g;

@@ -2,6 +2,7 @@
 // matrix times three columns (device-resident vectors on Vulkan: the kernel alone), and
 // SPD solves with three right-hand sides (CHOLMOD, prefactored, vs device Jacobi PCG
 // from a zero start to 1e-8).
+#include "MemoryCounters.h"
 #include "VulkanBenchSupport.h"
 #include "compute/vulkan/VulkanBackend.h"
 #include "compute/vulkan/VulkanLinearAlgebra.h"
@@ -13,6 +14,7 @@ using plano::compute::BackendChoice;
 void BM_Spmv(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::compute::SparseMatrix A = plano::bench::shiftedLaplacian(mesh, 1.0);
   const Eigen::MatrixXd X = mesh.vertices;
@@ -50,6 +52,7 @@ void BM_Spmv(benchmark::State& state, BackendChoice choice) {
 void BM_SpdSolve(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::compute::SparseMatrix A = plano::bench::shiftedLaplacian(mesh, 1.0);
   Eigen::MatrixXd B = mesh.vertices;

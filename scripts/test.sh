@@ -1,12 +1,29 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds Plano and runs the whole test suite (CPU and Vulkan on
-# lavapipe, validation layers on). This is exactly what CI runs.
+# Installs dependencies, builds Plano and runs everything CI checks, in three stages:
+#   1. Release build, the whole test suite (CPU and Vulkan on lavapipe, validation layers on);
+#   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer (scripts/sanitize.sh);
+#   3. a fuzz smoke run of every reader and the constraint parser (scripts/fuzz.sh).
+# This is exactly what CI runs. PLANO_TEST_STAGES (default "release sanitize fuzz") picks
+# stages for a quicker local loop; PLANO_FUZZ_SECONDS (default 30) bounds each fuzz target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-BUILD_DIR=${PLANO_BUILD_DIR:-build}
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)"
+stages=" ${PLANO_TEST_STAGES:-release sanitize fuzz} "
 # Without a GPU, the Vulkan tests run on Mesa's lavapipe.
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
-ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)"
+
+if [[ "$stages" == *" release "* ]]; then
+  echo "== stage 1/3: release build and tests" >&2
+  BUILD_DIR=${PLANO_BUILD_DIR:-build}
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$BUILD_DIR" -j"$(nproc)"
+  ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)"
+fi
+if [[ "$stages" == *" sanitize "* ]]; then
+  echo "== stage 2/3: AddressSanitizer + UndefinedBehaviorSanitizer build and tests" >&2
+  bash scripts/sanitize.sh
+fi
+if [[ "$stages" == *" fuzz "* ]]; then
+  echo "== stage 3/3: fuzz smoke run" >&2
+  bash scripts/fuzz.sh "${PLANO_FUZZ_SECONDS:-30}"
+fi

@@ -362,6 +362,22 @@ void Context::reserveMemory(VkDeviceSize bytes, std::uint32_t memoryType, const 
   }
   heapUsage_[heap] += bytes;
   totalUsage_ += bytes;
+  peakUsage_ = std::max(peakUsage_, totalUsage_);
+}
+
+VkDeviceSize Context::allocatedBytes() const {
+  std::lock_guard lock(allocationMutex_);
+  return totalUsage_;
+}
+
+VkDeviceSize Context::peakAllocatedBytes() const {
+  std::lock_guard lock(allocationMutex_);
+  return peakUsage_;
+}
+
+void Context::resetPeakAllocatedBytes() {
+  std::lock_guard lock(allocationMutex_);
+  peakUsage_ = totalUsage_;
 }
 
 void Context::releaseMemory(VkDeviceSize bytes, std::uint32_t memoryType) {

@@ -86,6 +86,11 @@ class Context {
   void reserveMemory(VkDeviceSize bytes, std::uint32_t memoryType, const char* what);
   /// Give back what reserveMemory accounted for (the allocation was freed).
   void releaseMemory(VkDeviceSize bytes, std::uint32_t memoryType);
+  /// Bytes of device memory allocated now, and the most allocated at once since creation
+  /// or the last resetPeakAllocatedBytes() (memory counters of the benchmarks).
+  VkDeviceSize allocatedBytes() const;
+  VkDeviceSize peakAllocatedBytes() const;
+  void resetPeakAllocatedBytes();
   /// What a queue submission reports to its caller: `result`, except VK_ERROR_DEVICE_LOST
   /// from the simulated lost submission on (SimulatedFaults::deviceLostAtSubmit).
   VkResult submissionResult(VkResult result);
@@ -118,9 +123,10 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool commandPool_ = VK_NULL_HANDLE;
 
-  std::mutex allocationMutex_;
+  mutable std::mutex allocationMutex_;
   std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS> heapUsage_{};  ///< Bytes allocated per heap.
   VkDeviceSize totalUsage_ = 0;
+  VkDeviceSize peakUsage_ = 0;
   std::uint64_t submissions_ = 0;
 
   mutable std::mutex messagesMutex_;
