@@ -15,6 +15,9 @@ namespace plano::compute {
 
 enum class BackendKind { Cpu, Vulkan };
 
+class AdmmSolver;     // compute/Admm.h
+struct AdmmSettings;  // compute/Admm.h
+
 /// Compressed-row sparse matrix, the layout both backends consume.
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
@@ -88,6 +91,12 @@ class Backend {
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;
+
+  /// An ADMM solver for the box-constrained QPs min 1/2 x'Px + q'x s.t. l <= Cx <= u
+  /// (compute/Admm.h), P and C uploaded or kept once. The default runs the iteration on
+  /// the host with createSpdSolver's solver; a device backend keeps it on the device.
+  virtual std::unique_ptr<AdmmSolver> createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
+                                                       const AdmmSettings& settings);
 };
 
 /// Which backend the user asked for.

@@ -10,6 +10,33 @@
 namespace plano::projective {
 namespace {
 
+compute::AdmmSettings admmSettings(const BoxQpSettings& s) {
+  compute::AdmmSettings a;
+  a.rho = s.rho;
+  a.equalityRhoScale = s.equalityRhoScale;
+  a.sigma = s.sigma;
+  a.relaxation = s.relaxation;
+  a.absoluteTolerance = s.absoluteTolerance;
+  a.relativeTolerance = s.relativeTolerance;
+  a.infeasibilityTolerance = s.infeasibilityTolerance;
+  a.maxIterations = s.maxIterations;
+  a.checkInterval = s.checkInterval;
+  a.adaptiveRho = s.adaptiveRho;
+  a.adaptiveRhoFactor = s.adaptiveRhoFactor;
+  a.linearSolver = s.linearSolver;
+  return a;
+}
+
+BoxQpStatus toBoxQpStatus(compute::AdmmStatus status) {
+  switch (status) {
+    case compute::AdmmStatus::Solved: return BoxQpStatus::Solved;
+    case compute::AdmmStatus::PrimalInfeasible: return BoxQpStatus::PrimalInfeasible;
+    case compute::AdmmStatus::MaxIterationsReached: return BoxQpStatus::MaxIterationsReached;
+    case compute::AdmmStatus::NonFinite: return BoxQpStatus::NonFinite;
+  }
+  return BoxQpStatus::MaxIterationsReached;
+}
+
 double infNorm(const Eigen::MatrixXd& m) { return m.size() == 0 ? 0.0 : m.cwiseAbs().maxCoeff(); }
 
 compute::SparseMatrix identity(Eigen::Index n, double value) {
@@ -37,138 +64,30 @@ const char* toString(BoxQpStatus status) {
 
 BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, compute::SparseMatrix C,
                          const BoxQpSettings& settings)
-    : backend_(backend), settings_(settings), P_(std::move(P)), C_(std::move(C)), rho_(settings.rho) {
+    : backend_(backend), settings_(settings), P_(std::move(P)), C_(std::move(C)) {
   if (P_.rows() != P_.cols() || C_.cols() != P_.rows()) {
     throwUsage("box QP: P is " + std::to_string(P_.rows()) + "x" + std::to_string(P_.cols()) + " and C is " +
                std::to_string(C_.rows()) + "x" + std::to_string(C_.cols()) + " (need n x n and m x n)");
   }
-  Ct_ = C_.transpose();
-}
-
-void BoxQpSolver::factor(const Eigen::VectorXd& rhoPerRow) {
-  const compute::SparseMatrix K =
-      P_ + identity(P_.rows(), settings_.sigma) + compute::SparseMatrix(Ct_ * rhoPerRow.asDiagonal() * C_);
-  solver_ = backend_.createSpdSolver(K, settings_.linearSolver);
-  factoredRho_ = rhoPerRow;
+  admm_ = backend_.createAdmmSolver(P_, C_, admmSettings(settings_));
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
-  const Eigen::Index n = P_.rows();
-  const Eigen::Index m = C_.rows();
-  const Eigen::Index k = q.cols();
-  if (q.rows() != n || lower.rows() != m || upper.rows() != m || lower.cols() != k || upper.cols() != k) {
-    throwUsage("box QP: q, lower and upper must be n x k, m x k, m x k");
-  }
-  if ((lower.array() > upper.array()).any()) throwUsage("box QP: a lower bound exceeds its upper bound");
-  if (x.size() == 0) x = Eigen::MatrixXd::Zero(n, k);
-  if (y.size() == 0) y = Eigen::MatrixXd::Zero(m, k);
-  if (x.rows() != n || x.cols() != k || y.rows() != m || y.cols() != k) {
-    throwUsage("box QP: warm starts x and y must be n x k and m x k");
-  }
-
-  std::vector<char> equality(m);
-  for (Eigen::Index i = 0; i < m; ++i) equality[i] = (lower.row(i).array() == upper.row(i).array()).all();
-  auto rhoVector = [&] {
-    Eigen::VectorXd r(m);
-    for (Eigen::Index i = 0; i < m; ++i) r[i] = equality[i] ? rho_ * settings_.equalityRhoScale : rho_;
-    return r;
-  };
+  Eigen::MatrixXd z;
+  const compute::AdmmInfo admm = admm_->solve(q, lower, upper, x, y, z);
   BoxQpInfo info;
-  Eigen::VectorXd rho = rhoVector();
-  if (!solver_ || factoredRho_.size() != m || factoredRho_ != rho) {
-    factor(rho);
-    ++info.factorizations;
-  }
-
-  const double alpha = settings_.relaxation;
-  Eigen::MatrixXd z = (C_ * x).cwiseMax(lower).cwiseMin(upper);
-  Eigen::MatrixXd xTilde = x;
-  Eigen::MatrixXd yPrevious = y;
-  const double qNorm = infNorm(q);
-
-  // Residuals, tolerances and the rho balance at the current iterate. Returns true when converged.
-  double rhoBalance = 1.0;
-  auto converged = [&]() {
-    const Eigen::MatrixXd Cx = C_ * x;
-    const Eigen::MatrixXd Px = P_ * x;
-    const Eigen::MatrixXd Cty = Ct_ * y;
-    info.primalResidual = infNorm(Cx - z);
-    info.dualResidual = infNorm(Px + q + Cty);
-    const double primalScale = std::max(infNorm(Cx), infNorm(z));
-    const double dualScale = std::max({infNorm(Px), infNorm(Cty), qNorm});
-    const double epsPrimal = settings_.absoluteTolerance + settings_.relativeTolerance * primalScale;
-    const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
-    const double tiny = 1e-30;
-    rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /
-                           std::max(info.dualResidual / std::max(dualScale, tiny), tiny));
-    return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
-  };
-
-  // OSQP's primal infeasibility certificate from the last dual step dy: C^T dy ~ 0 and
-  // u^T max(dy, 0) + l^T min(dy, 0) < 0 (for the dy normalized to unit inf-norm).
-  auto infeasible = [&]() {
-    const Eigen::MatrixXd dy = y - yPrevious;
-    for (Eigen::Index c = 0; c < k; ++c) {
-      const double norm = dy.col(c).cwiseAbs().maxCoeff();
-      if (!(norm > 0.0)) continue;
-      const Eigen::VectorXd d = dy.col(c) / norm;
-      const double support = upper.col(c).dot(d.cwiseMax(0.0)) + lower.col(c).dot(d.cwiseMin(0.0));
-      if (infNorm(Ct_ * d) <= settings_.infeasibilityTolerance && support <= -settings_.infeasibilityTolerance) {
-        return true;
-      }
-    }
-    return false;
-  };
-
-  if (converged()) {
-    info.status = BoxQpStatus::Solved;
-  } else {
-    for (int iteration = 1; iteration <= settings_.maxIterations; ++iteration) {
-      const bool check = iteration % settings_.checkInterval == 0 || iteration == settings_.maxIterations;
-      const Eigen::MatrixXd rhs = settings_.sigma * x - q + Ct_ * (rho.asDiagonal() * z - y);
-      solver_->solve(rhs, xTilde);
-      const Eigen::MatrixXd zTilde = C_ * xTilde;
-      x = alpha * xTilde + (1.0 - alpha) * x;
-      const Eigen::MatrixXd zRelaxed = alpha * zTilde + (1.0 - alpha) * z;
-      const Eigen::MatrixXd zNext =
-          (zRelaxed + rho.cwiseInverse().asDiagonal() * y).cwiseMax(lower).cwiseMin(upper);
-      if (check) yPrevious = y;
-      y += rho.asDiagonal() * (zRelaxed - zNext);
-      z = zNext;
-      info.iterations = iteration;
-      if (!check) continue;
-      if (!x.allFinite() || !y.allFinite()) {
-        info.status = BoxQpStatus::NonFinite;
-        break;
-      }
-      if (converged()) {
-        info.status = BoxQpStatus::Solved;
-        break;
-      }
-      if (infeasible()) {
-        info.status = BoxQpStatus::PrimalInfeasible;
-        break;
-      }
-      if (settings_.adaptiveRho) {
-        const double proposed = std::clamp(rho_ * rhoBalance, 1e-6, 1e6);
-        if (proposed > rho_ * settings_.adaptiveRhoFactor || proposed < rho_ / settings_.adaptiveRhoFactor) {
-          rho_ = proposed;
-          rho = rhoVector();
-          factor(rho);
-          ++info.factorizations;
-        }
-      }
-    }
-  }
-
+  info.status = toBoxQpStatus(admm.status);
+  info.iterations = admm.iterations;
+  info.factorizations = admm.factorizations;
+  info.primalResidual = admm.primalResidual;
+  info.dualResidual = admm.dualResidual;
+  info.rho = admm.rho;
   if (info.status == BoxQpStatus::Solved && settings_.polish && info.iterations > 0) {
     info.polished = polish(q, lower, upper, z, x, y);
   }
-  const Eigen::MatrixXd Cx = C_ * x;
-  info.maxBoundViolation = boundViolation(Cx, lower, upper);
+  info.maxBoundViolation = boundViolation(C_ * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
-  info.rho = rho_;
   return info;
 }
 

@@ -6,15 +6,18 @@
 //
 // for k independent columns x_c that share P (n x n, symmetric positive definite) and C
 // (m x n) and differ in q, l and u. The iteration follows OSQP (Stellato et al. 2020):
-// the only linear system is K = P + sigma I + C^T diag(rho) C, solved through
-// Backend::createSpdSolver (prefactored CHOLMOD on the CPU, PCG on a GPU), one solve for
-// all k columns; rows with l = u get a 1e3 times stiffer rho, as in OSQP. rho adapts to
-// the ratio of the residuals (K is refactored only when rho changes by more than
-// `adaptiveRhoFactor`); a converged solution is polished by re-solving with the active
-// bounds as equalities, which removes the ADMM's residual tolerance from the answer.
+// the only linear system is K = P + sigma I + C^T diag(rho) C, one solve for all k
+// columns; rows with l = u get a 1e3 times stiffer rho, as in OSQP. rho adapts to the
+// ratio of the residuals (K changes only when rho moves by more than
+// `adaptiveRhoFactor`). The iteration itself is the backend's (Backend::createAdmmSolver,
+// compute/Admm.h): on the CPU the Eigen loop with a prefactored Cholesky, on Vulkan the
+// whole loop on the device. A converged solution is then polished here, on the host, by
+// re-solving with the active bounds as equalities, which removes the ADMM's residual
+// tolerance from the answer.
 #include <Eigen/Core>
 #include <memory>
 
+#include "compute/Admm.h"
 #include "compute/Backend.h"
 
 namespace plano::projective {
@@ -59,7 +62,8 @@ struct BoxQpInfo {
 
 class BoxQpSolver {
  public:
-  /// Precompute: keeps P (n x n) and C (m x n); K is factored on the first solve.
+  /// Precompute: keeps P (n x n) and C (m x n) and creates the backend's ADMM solver; K
+  /// is formed on the first solve.
   BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, compute::SparseMatrix C,
               const BoxQpSettings& settings = {});
 
@@ -68,15 +72,14 @@ class BoxQpSolver {
   ///   lower, upper  in: m x k bounds (lower <= upper; equal for equality rows).
   ///   x     in/out: n x k, warm start on entry (zero if empty), solution on exit.
   ///   y     in/out: m x k dual variables, warm start on entry (zero if empty).
-  /// Rows whose bounds are equal in every column are equality rows. K is refactored when
-  /// the equality pattern or rho changed since the last solve.
+  /// Rows whose bounds are equal in every column are equality rows. K changes when the
+  /// equality pattern or rho changed since the last solve.
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
   const BoxQpSettings& settings() const { return settings_; }
 
  private:
-  void factor(const Eigen::VectorXd& rhoPerRow);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
@@ -84,10 +87,7 @@ class BoxQpSolver {
   BoxQpSettings settings_;
   compute::SparseMatrix P_;
   compute::SparseMatrix C_;
-  compute::SparseMatrix Ct_;
-  std::unique_ptr<compute::SpdSolver> solver_;
-  Eigen::VectorXd factoredRho_;  ///< rho per row of the current factorization.
-  double rho_ = 0.1;
+  std::unique_ptr<compute::AdmmSolver> admm_;
 };
 
 }  // namespace plano::projective

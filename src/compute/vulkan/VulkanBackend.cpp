@@ -1,5 +1,6 @@
 #include "compute/vulkan/VulkanBackend.h"
 
+#include "compute/vulkan/VulkanAdmm.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "compute/vulkan/VulkanClosestRotations.h"
 #include "compute/vulkan/VulkanFacePlanarity.h"
@@ -37,6 +38,12 @@ void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, 
 
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
   return std::make_unique<vk::PcgSolver>(*context_, A, settings);
+}
+
+std::unique_ptr<AdmmSolver> VulkanBackend::createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
+                                                           const AdmmSettings& settings) {
+  return std::make_unique<AdmmSolver>(std::make_unique<vk::AdmmKernels>(*context_, P, C, settings), P.rows(),
+                                      C.rows(), settings);
 }
 
 std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference preference) {

@@ -37,6 +37,11 @@ class VulkanBackend final : public Backend {
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
 
+  /// The ADMM iteration on the device (vk::AdmmKernels): only the checks' inf-norms come
+  /// back to the host. Like the SPD solver, it must not outlive the backend.
+  std::unique_ptr<AdmmSolver> createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
+                                               const AdmmSettings& settings) override;
+
   /// The device context (device properties, validation messages).
   vk::Context& context() { return *context_; }
 

@@ -23,8 +23,9 @@ Buffer::Buffer(Context& context, std::size_t bytes, MemoryClass memoryClass, con
   }
   auto info = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
   info.size = bytes_;
+  // Indirect: kernels may size later dispatches (the device ADMM's inner PCG).
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-               VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+               VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   const VkResult created = vkCreateBuffer(device, &info, nullptr, &buffer_);
   if (created != VK_SUCCESS) {

@@ -24,6 +24,10 @@ struct AxpbyPush {
 struct ScalePush {
   std::uint32_t n, m;
 };
+struct MaxAbsPush {
+  std::uint32_t n, terms;
+  double b, c;
+};
 struct CountPush {
   std::uint32_t count;
 };
@@ -106,7 +110,9 @@ LinearAlgebra::LinearAlgebra(Context& context)
       reduce_(context, "la_reduce", 2, sizeof(ReducePush)),
       axpby_(context, "la_axpby", 2, sizeof(AxpbyPush)),
       scaleRows_(context, "la_scale_rows", 3, sizeof(ScalePush)),
-      clamp_(context, "la_clamp", 4, sizeof(CountPush)) {}
+      clamp_(context, "la_clamp", 4, sizeof(CountPush)),
+      maxAbs_(context, "la_max_abs", 4, sizeof(MaxAbsPush)),
+      reduceMax_(context, "la_reduce_max", 2, sizeof(ReducePush)) {}
 
 void LinearAlgebra::spmv(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceVectors& X, DeviceVectors& Y) {
   if (X.n() != A.cols() || Y.n() != A.rows() || X.m() != Y.m()) {
@@ -132,6 +138,34 @@ void LinearAlgebra::dot(Sequence& sequence, const DeviceVectors& X, const Device
 void LinearAlgebra::reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot) {
   if (slot >= scalars.slots_) throwUsage("reduce: slot " + std::to_string(slot) + " out of range");
   sequence.dispatch(reduce_, {scalars.partial_, scalars.values_}, ReducePush{scalars.groups_, scalars.m_, slot},
+                    scalars.m_);
+  sequence.barrier();
+}
+
+void LinearAlgebra::maxAbs(Sequence& sequence, const DeviceVectors& X, DeviceScalars& scalars, std::uint32_t slot) {
+  maxAbs(sequence, 1, X, 0.0, X, 0.0, X, scalars, slot);
+}
+
+void LinearAlgebra::maxAbs(Sequence& sequence, const DeviceVectors& X, double b, const DeviceVectors& Y,
+                           DeviceScalars& scalars, std::uint32_t slot) {
+  maxAbs(sequence, 2, X, b, Y, 0.0, Y, scalars, slot);
+}
+
+void LinearAlgebra::maxAbs(Sequence& sequence, const DeviceVectors& X, double b, const DeviceVectors& Y, double c,
+                           const DeviceVectors& Z, DeviceScalars& scalars, std::uint32_t slot) {
+  maxAbs(sequence, 3, X, b, Y, c, Z, scalars, slot);
+}
+
+void LinearAlgebra::maxAbs(Sequence& sequence, std::uint32_t terms, const DeviceVectors& X, double b,
+                           const DeviceVectors& Y, double c, const DeviceVectors& Z, DeviceScalars& scalars,
+                           std::uint32_t slot) {
+  requireSameShape(X, Y, "maxAbs");
+  requireSameShape(X, Z, "maxAbs");
+  if (scalars.m() != X.m() || slot >= scalars.slots_) throwUsage("maxAbs: scalars do not match the vectors");
+  sequence.dispatch(maxAbs_, {X.data(), Y.data(), Z.data(), scalars.partial_}, MaxAbsPush{X.n(), terms, b, c},
+                    scalars.groups_, X.m());
+  sequence.barrier();
+  sequence.dispatch(reduceMax_, {scalars.partial_, scalars.values_}, ReducePush{scalars.groups_, scalars.m_, slot},
                     scalars.m_);
   sequence.barrier();
 }

@@ -1,7 +1,7 @@
 #pragma once
 // Sparse and dense linear algebra on the device, the building blocks of the global steps
 // (the PCG solve here, a device ADMM later): CSR matrix-vector products, column-wise dot
-// products with two-pass workgroup reductions, axpby, row scaling and box projection.
+// products and inf-norms with two-pass workgroup reductions, axpby, row scaling and box projection.
 //
 // Vectors come in blocks of m columns of n entries (column-major), so that the three
 // coordinates of a mesh-sized unknown are one dispatch. Operations are *recorded* into a
@@ -92,6 +92,13 @@ class LinearAlgebra {
   /// Second pass of a dot product whose partial sums are already in scalars.partial():
   /// scalars[slot][c] = sum of the column's partial sums.
   void reduce(Sequence& sequence, DeviceScalars& scalars, std::uint32_t slot);
+  /// scalars[slot][c] = ||X(:, c)||_inf, ||X(:, c) + b Y(:, c)||_inf or
+  /// ||X(:, c) + b Y(:, c) + c Z(:, c)||_inf (max-abs reductions; NaN propagates).
+  void maxAbs(Sequence& sequence, const DeviceVectors& X, DeviceScalars& scalars, std::uint32_t slot);
+  void maxAbs(Sequence& sequence, const DeviceVectors& X, double b, const DeviceVectors& Y, DeviceScalars& scalars,
+              std::uint32_t slot);
+  void maxAbs(Sequence& sequence, const DeviceVectors& X, double b, const DeviceVectors& Y, double c,
+              const DeviceVectors& Z, DeviceScalars& scalars, std::uint32_t slot);
   /// Y = a X + b Y.
   void axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y);
   /// Y = diag(d) X, d of n entries applied to every column.
@@ -105,6 +112,9 @@ class LinearAlgebra {
   Context& context() { return context_; }
 
  private:
+  void maxAbs(Sequence& sequence, std::uint32_t terms, const DeviceVectors& X, double b, const DeviceVectors& Y,
+              double c, const DeviceVectors& Z, DeviceScalars& scalars, std::uint32_t slot);
+
   Context& context_;
   Pipeline spmv_;
   Pipeline dot_;
@@ -112,6 +122,8 @@ class LinearAlgebra {
   Pipeline axpby_;
   Pipeline scaleRows_;
   Pipeline clamp_;
+  Pipeline maxAbs_;
+  Pipeline reduceMax_;
 };
 
 }  // namespace plano::vk

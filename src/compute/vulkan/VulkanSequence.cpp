@@ -52,6 +52,19 @@ void Sequence::begin() {
 
 void Sequence::dispatch(const Pipeline& pipeline, const DescriptorSet& set, std::span<const std::byte> pushConstants,
                         std::uint32_t groupsX, std::uint32_t groupsY) {
+  bind(pipeline, set, pushConstants);
+  vkCmdDispatch(commands_, groupsX, groupsY, 1);
+}
+
+void Sequence::dispatchIndirect(const Buffer& arguments, std::size_t offset) {
+  if (offset % 4 != 0 || offset + 3 * sizeof(std::uint32_t) > arguments.bytes()) {
+    throwDevice("Vulkan: indirect dispatch arguments at byte " + std::to_string(offset) + " of a " +
+                std::to_string(arguments.bytes()) + "-byte buffer");
+  }
+  vkCmdDispatchIndirect(commands_, arguments.handle(), offset);
+}
+
+void Sequence::bind(const Pipeline& pipeline, const DescriptorSet& set, std::span<const std::byte> pushConstants) {
   if (!recording_) throwDevice("Vulkan: dispatch of '" + pipeline.name() + "' outside begin()/end()");
   if (pushConstants.size() != pipeline.pushConstantBytes()) {
     throwDevice("Vulkan: pipeline '" + pipeline.name() + "' takes " + std::to_string(pipeline.pushConstantBytes()) +
@@ -64,16 +77,16 @@ void Sequence::dispatch(const Pipeline& pipeline, const DescriptorSet& set, std:
     vkCmdPushConstants(commands_, pipeline.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
                        static_cast<std::uint32_t>(pushConstants.size()), pushConstants.data());
   }
-  vkCmdDispatch(commands_, groupsX, groupsY, 1);
 }
 
 void Sequence::barrier() {
   auto memory = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
   memory.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   memory.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                         VK_ACCESS_TRANSFER_WRITE_BIT;
+                         VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
   const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-  vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &memory, 0, nullptr, 0, nullptr);
+  vkCmdPipelineBarrier(commands_, stages, stages | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, 0, 1, &memory, 0, nullptr, 0,
+                       nullptr);
 }
 
 void Sequence::copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset,

@@ -36,7 +36,16 @@ class Sequence {
     sets_.push_back(std::make_unique<DescriptorSet>(context_, pipeline, buffers));
     dispatch(pipeline, *sets_.back(), push, groupsX, groupsY);
   }
-  /// Make every earlier shader or transfer write visible to every later shader or transfer.
+  /// Record a dispatch whose workgroup counts (three uint32) are read from `arguments` at
+  /// byte `offset` when it runs: a kernel recorded earlier can size it, or make it empty.
+  template <class Push>
+  void dispatchIndirect(const Pipeline& pipeline, const DescriptorSet& set, const Push& push, const Buffer& arguments,
+                        std::size_t offset) {
+    bind(pipeline, set, std::as_bytes(std::span<const Push>(&push, 1)));
+    dispatchIndirect(arguments, offset);
+  }
+  /// Make every earlier shader or transfer write visible to every later shader, transfer
+  /// or indirect dispatch.
   void barrier();
   void copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset = 0,
             std::size_t destinationOffset = 0);
@@ -53,6 +62,9 @@ class Sequence {
   double lastDeviceSeconds() const;
 
  private:
+  void bind(const Pipeline& pipeline, const DescriptorSet& set, std::span<const std::byte> pushConstants);
+  void dispatchIndirect(const Buffer& arguments, std::size_t offset);
+
   Context& context_;
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -1,0 +1,59 @@
+#version 450
+// Device-side convergence control of a PCG solve recorded as a fixed number of iterations
+// (the inner solve of the device ADMM). Run before each recorded iteration, it writes the
+// indirect dispatch sizes of that iteration: its full sizes while some column still has
+// r.z > tol^2 b.z, zero once all have converged, so the rest of the recorded iterations
+// cost empty dispatches and the solution is that of a PCG stopped at the tolerance. NaN
+// counts as not converged, so that it reaches the iterate. state: [0] done flag of this
+// solve, [1] iterations run, [2] solves stopped by the recorded cap.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 1) in;
+
+layout(std430, binding = 0) readonly buffer Scalars { double scalars[]; };
+layout(std430, binding = 1) buffer State { double state[]; };
+layout(std430, binding = 2) writeonly buffer Arguments { uint arguments[]; };
+
+layout(push_constant) uniform Push {
+  uint m;
+  uint slotRz;
+  uint slotBz;
+  uint mode;  // 0: first check of a solve, 1: later check, 2: after the last recorded iteration
+  uint groupsColumn;     // workgroups per column of the fused PCG kernels
+  uint groupsDirection;  // workgroups of the direction update
+  uint pad0;
+  uint pad1;
+  double tolerance2;
+} pc;
+
+void main() {
+  if (pc.mode == 0) state[0] = 0.0;
+  bool running = state[0] == 0.0;
+  if (running) {
+    bool any = false;
+    for (uint c = 0; c < pc.m; ++c) {
+      if (!(scalars[pc.slotRz * pc.m + c] <= pc.tolerance2 * scalars[pc.slotBz * pc.m + c])) any = true;
+    }
+    running = any;
+  }
+  if (pc.mode == 2) {
+    if (running) state[2] += 1.0;
+    return;
+  }
+  if (running) {
+    state[1] += 1.0;
+  } else {
+    state[0] = 1.0;
+  }
+  // [0..2]: fused kernels (groupsColumn x m), [3..5]: reductions (m), [6..8]: direction.
+  arguments[0] = running ? pc.groupsColumn : 0;
+  arguments[1] = pc.m;
+  arguments[2] = 1;
+  arguments[3] = running ? pc.m : 0;
+  arguments[4] = 1;
+  arguments[5] = 1;
+  arguments[6] = running ? pc.groupsDirection : 0;
+  arguments[7] = 1;
+  arguments[8] = 1;
+}

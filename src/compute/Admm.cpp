@@ -1,0 +1,230 @@
+#include "compute/Admm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::compute {
+namespace {
+
+/// Column-wise inf-norms; NaN propagates (Eigen's maxCoeff would skip it).
+Eigen::VectorXd columnInfNorms(const Eigen::MatrixXd& m) {
+  Eigen::VectorXd norms = Eigen::VectorXd::Zero(m.cols());
+  for (Eigen::Index c = 0; c < m.cols(); ++c) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) {
+      const double a = std::abs(m(i, c));
+      if (a > norms[c] || std::isnan(a)) norms[c] = a;
+      if (std::isnan(a)) break;
+    }
+  }
+  return norms;
+}
+
+double maxOf(const Eigen::VectorXd& v) { return v.size() == 0 ? 0.0 : v.maxCoeff(); }
+
+bool allFinite(const Eigen::VectorXd& v) { return v.allFinite(); }
+
+/// The Eigen loop: every step of AdmmKernels::iterate as one matrix expression, K solved
+/// by the backend's SPD solver (refactored when rho changes).
+class HostAdmmKernels final : public AdmmKernels {
+ public:
+  HostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C, const AdmmSettings& settings)
+      : backend_(backend), settings_(settings), P_(P), C_(C), Ct_(C.transpose()) {}
+
+  void setRho(const std::vector<char>& equality, double rho) override {
+    rho_.resize(static_cast<Eigen::Index>(equality.size()));
+    for (std::size_t i = 0; i < equality.size(); ++i) rho_[i] = equality[i] ? rho * settings_.equalityRhoScale : rho;
+    SparseMatrix I(P_.rows(), P_.rows());
+    I.setIdentity();
+    const SparseMatrix K = P_ + I * settings_.sigma + SparseMatrix(Ct_ * rho_.asDiagonal() * C_);
+    solver_ = backend_.createSpdSolver(K, settings_.linearSolver);
+  }
+
+  void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+             const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
+    q_ = q;
+    lower_ = lower;
+    upper_ = upper;
+    x_ = x;
+    y_ = y;
+    z_ = (C_ * x_).cwiseMax(lower_).cwiseMin(upper_);
+    xTilde_ = x_;
+    yPrevious_ = y_;
+    linearIterations_ = 0;
+  }
+
+  void iterate(int count) override {
+    const double alpha = settings_.relaxation;
+    for (int i = 0; i < count; ++i) {
+      const Eigen::MatrixXd rhs = settings_.sigma * x_ - q_ + Ct_ * (rho_.asDiagonal() * z_ - y_);
+      linearIterations_ += solver_->solve(rhs, xTilde_).iterations;
+      const Eigen::MatrixXd zTilde = C_ * xTilde_;
+      x_ = alpha * xTilde_ + (1.0 - alpha) * x_;
+      const Eigen::MatrixXd zRelaxed = alpha * zTilde + (1.0 - alpha) * z_;
+      const Eigen::MatrixXd zNext =
+          (zRelaxed + rho_.cwiseInverse().asDiagonal() * y_).cwiseMax(lower_).cwiseMin(upper_);
+      if (i == count - 1) yPrevious_ = y_;
+      y_ += rho_.asDiagonal() * (zRelaxed - zNext);
+      z_ = zNext;
+    }
+  }
+
+  AdmmMeasures measure() override {
+    AdmmMeasures s;
+    const Eigen::MatrixXd Cx = C_ * x_;
+    const Eigen::MatrixXd Px = P_ * x_;
+    const Eigen::MatrixXd Cty = Ct_ * y_;
+    const Eigen::MatrixXd dy = y_ - yPrevious_;
+    s.primalResidual = columnInfNorms(Cx - z_);
+    s.dualResidual = columnInfNorms(Px + q_ + Cty);
+    s.Cx = columnInfNorms(Cx);
+    s.z = columnInfNorms(z_);
+    s.Px = columnInfNorms(Px);
+    s.Cty = columnInfNorms(Cty);
+    s.q = columnInfNorms(q_);
+    s.x = columnInfNorms(x_);
+    s.y = columnInfNorms(y_);
+    s.dy = columnInfNorms(dy);
+    s.Ctdy = columnInfNorms(Ct_ * dy);
+    s.support.resize(dy.cols());
+    for (Eigen::Index c = 0; c < dy.cols(); ++c) {
+      s.support[c] = upper_.col(c).dot(dy.col(c).cwiseMax(0.0)) + lower_.col(c).dot(dy.col(c).cwiseMin(0.0));
+    }
+    s.linearIterations = linearIterations_;
+    return s;
+  }
+
+  void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override {
+    x = x_;
+    y = y_;
+    z = z_;
+  }
+
+ private:
+  Backend& backend_;
+  AdmmSettings settings_;
+  SparseMatrix P_, C_, Ct_;
+  std::unique_ptr<SpdSolver> solver_;
+  Eigen::VectorXd rho_;
+  Eigen::MatrixXd q_, lower_, upper_, x_, y_, z_, xTilde_, yPrevious_;
+  long linearIterations_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<AdmmKernels> createHostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C,
+                                                   const AdmmSettings& settings) {
+  return std::make_unique<HostAdmmKernels>(backend, P, C, settings);
+}
+
+std::unique_ptr<AdmmSolver> Backend::createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
+                                                      const AdmmSettings& settings) {
+  return std::make_unique<AdmmSolver>(createHostAdmmKernels(*this, P, C, settings), P.rows(), C.rows(), settings);
+}
+
+AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eigen::Index m,
+                       const AdmmSettings& settings)
+    : kernels_(std::move(kernels)), n_(n), m_(m), settings_(settings), rho_(settings.rho) {
+  if (settings_.checkInterval < 1) throwUsage("ADMM: checkInterval must be at least 1");
+}
+
+AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                           Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
+  const Eigen::Index k = q.cols();
+  if (q.rows() != n_ || lower.rows() != m_ || upper.rows() != m_ || lower.cols() != k || upper.cols() != k) {
+    throwUsage("ADMM: q, lower and upper must be n x k, m x k, m x k");
+  }
+  if ((lower.array() > upper.array()).any()) throwUsage("ADMM: a lower bound exceeds its upper bound");
+  if (x.size() == 0) x = Eigen::MatrixXd::Zero(n_, k);
+  if (y.size() == 0) y = Eigen::MatrixXd::Zero(m_, k);
+  if (x.rows() != n_ || x.cols() != k || y.rows() != m_ || y.cols() != k) {
+    throwUsage("ADMM: warm starts x and y must be n x k and m x k");
+  }
+
+  std::vector<char> equality(m_);
+  for (Eigen::Index i = 0; i < m_; ++i) equality[i] = (lower.row(i).array() == upper.row(i).array()).all();
+  AdmmInfo info;
+  if (!factored_ || equality != factoredEquality_ || factoredRho_ != rho_) {
+    kernels_->setRho(equality, rho_);
+    factored_ = true;
+    factoredEquality_ = equality;
+    factoredRho_ = rho_;
+    ++info.factorizations;
+  }
+  kernels_->start(q, lower, upper, x, y);
+
+  // Residuals, tolerances and the rho balance at the current iterate. Returns true when converged.
+  AdmmMeasures s;
+  double rhoBalance = 1.0;
+  auto converged = [&]() {
+    info.primalResidual = maxOf(s.primalResidual);
+    info.dualResidual = maxOf(s.dualResidual);
+    const double primalScale = std::max(maxOf(s.Cx), maxOf(s.z));
+    const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
+    const double epsPrimal = settings_.absoluteTolerance + settings_.relativeTolerance * primalScale;
+    const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
+    const double tiny = 1e-30;
+    rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /
+                           std::max(info.dualResidual / std::max(dualScale, tiny), tiny));
+    return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
+  };
+
+  // OSQP's primal infeasibility certificate from the last dual step dy: for d = dy/||dy||,
+  // C^T d ~ 0 and u^T max(d, 0) + l^T min(d, 0) < 0. Both are positively homogeneous, so
+  // the kernels measure dy and the normalization happens here.
+  auto infeasible = [&]() {
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const double norm = s.dy[c];
+      if (!(norm > 0.0)) continue;
+      if (s.Ctdy[c] / norm <= settings_.infeasibilityTolerance &&
+          s.support[c] / norm <= -settings_.infeasibilityTolerance) {
+        return true;
+      }
+    }
+    return false;
+  };
+
+  s = kernels_->measure();
+  if (converged()) {
+    info.status = AdmmStatus::Solved;
+  } else {
+    while (info.iterations < settings_.maxIterations) {
+      // Checks at multiples of checkInterval and at maxIterations, as in OSQP.
+      const int next = std::min(settings_.maxIterations,
+                                (info.iterations / settings_.checkInterval + 1) * settings_.checkInterval);
+      kernels_->iterate(next - info.iterations);
+      info.iterations = next;
+      s = kernels_->measure();
+      if (!allFinite(s.x) || !allFinite(s.y)) {
+        info.status = AdmmStatus::NonFinite;
+        break;
+      }
+      if (converged()) {
+        info.status = AdmmStatus::Solved;
+        break;
+      }
+      if (infeasible()) {
+        info.status = AdmmStatus::PrimalInfeasible;
+        break;
+      }
+      if (settings_.adaptiveRho) {
+        const double proposed = std::clamp(rho_ * rhoBalance, 1e-6, 1e6);
+        if (proposed > rho_ * settings_.adaptiveRhoFactor || proposed < rho_ / settings_.adaptiveRhoFactor) {
+          rho_ = proposed;
+          kernels_->setRho(equality, rho_);
+          factoredRho_ = rho_;
+          ++info.factorizations;
+        }
+      }
+    }
+  }
+  info.rho = rho_;
+  info.linearIterations = s.linearIterations;
+  info.inexactSolves = s.inexactSolves;
+  kernels_->download(x, y, z);
+  return info;
+}
+
+}  // namespace plano::compute

@@ -1,0 +1,124 @@
+#pragma once
+// OSQP-style ADMM (Stellato et al. 2020) for box-constrained QPs with k right-hand-side
+// columns that share one matrix:
+//
+//   minimize  sum_c 1/2 x_c^T P x_c + q_c^T x_c   subject to  l_c <= C x_c <= u_c.
+//
+// The algorithm is split in two so that it exists once:
+//  - AdmmSolver (here, host): the control logic. It decides when to check, evaluates the
+//    convergence test and the primal-infeasibility certificate from a handful of
+//    per-column inf-norms, detects non-finite iterates and adapts rho.
+//  - AdmmKernels (per backend): the vector work. start() loads the problem, iterate()
+//    runs a block of plain ADMM iterations, measure() returns the inf-norms, setRho()
+//    changes K = P + sigma I + C^T diag(rho) C. The host kernels (HostAdmmKernels) run the
+//    Eigen loop with a Backend SPD solver; the Vulkan kernels record the same steps as
+//    compute shaders, so between two checks nothing but the block's submit crosses the bus.
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "compute/Backend.h"
+
+namespace plano::compute {
+
+struct AdmmSettings {
+  double rho = 0.1;                      ///< Initial penalty of inequality rows.
+  double equalityRhoScale = 1e3;         ///< rho of rows with l = u, relative to rho.
+  double sigma = 1e-6;                   ///< Proximal term: keeps K definite for a PSD P.
+  double relaxation = 1.6;               ///< Over-relaxation alpha in (0, 2).
+  double absoluteTolerance = 1e-6;       ///< eps_abs of the primal and dual residuals (inf-norms).
+  double relativeTolerance = 1e-6;       ///< eps_rel, relative to the sizes of the terms.
+  double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
+  int maxIterations = 4000;
+  int checkInterval = 10;                ///< Residuals and certificates every this many iterations.
+  bool adaptiveRho = true;
+  double adaptiveRhoFactor = 5.0;        ///< Change K only when rho moves by more than this factor.
+  LinearSolverSettings linearSolver;     ///< Of the solves with K (iterative backends).
+};
+
+enum class AdmmStatus {
+  Solved,               ///< Primal and dual residuals below their tolerances.
+  PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
+  MaxIterationsReached, ///< Neither converged nor proven infeasible.
+  NonFinite,            ///< NaN or Inf appeared in the iteration.
+};
+
+struct AdmmInfo {
+  AdmmStatus status = AdmmStatus::MaxIterationsReached;
+  int iterations = 0;          ///< ADMM iterations.
+  int factorizations = 0;      ///< Changes of K (first one + rho updates).
+  double primalResidual = 0.0; ///< ||C x - z||_inf over all columns at the last check.
+  double dualResidual = 0.0;   ///< ||P x + q + C^T y||_inf over all columns at the last check.
+  double rho = 0.0;            ///< Final rho (of inequality rows).
+  long linearIterations = 0;   ///< Iterations of the solves with K (1 per direct solve).
+  long inexactSolves = 0;      ///< Solves with K stopped by an iteration cap (iterative backends).
+};
+
+/// Per-column inf-norms at the current iterate (vectors of k entries); all a check needs.
+/// dy = y - y at the start of the last iteration (zero before the first iteration).
+struct AdmmMeasures {
+  Eigen::VectorXd primalResidual;  ///< ||C x - z||
+  Eigen::VectorXd dualResidual;    ///< ||P x + q + C^T y||
+  Eigen::VectorXd Cx, z, Px, Cty, q;  ///< Sizes of the terms (relative tolerances).
+  Eigen::VectorXd x, y;            ///< Non-finite detection (NaN propagates into the norm).
+  Eigen::VectorXd dy;              ///< ||dy||
+  Eigen::VectorXd Ctdy;            ///< ||C^T dy||
+  Eigen::VectorXd support;         ///< u^T max(dy, 0) + l^T min(dy, 0) (not a norm).
+  long linearIterations = 0;       ///< Since start().
+  long inexactSolves = 0;          ///< Since start().
+};
+
+/// The vector work of one backend (see the file comment). Implementations keep x, y, z,
+/// xTilde, the previous y and the problem data; the k columns come with start().
+class AdmmKernels {
+ public:
+  virtual ~AdmmKernels() = default;
+  /// Set K = P + sigma I + C^T diag(r) C with r_i = rho * (equality[i] ? scale : 1).
+  virtual void setRho(const std::vector<char>& equality, double rho) = 0;
+  /// Load q (n x k), bounds (m x k) and warm starts; z = clamp(C x, l, u), xTilde = x.
+  virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                     const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
+  /// `count` ADMM iterations (OSQP Algorithm 1, with the current rho):
+  ///   xTilde = K^-1 (sigma x - q + C^T (rho z - y))   (warm-started at the last xTilde)
+  ///   zTilde = C xTilde
+  ///   x = alpha xTilde + (1 - alpha) x,  zR = alpha zTilde + (1 - alpha) z
+  ///   zNext = clamp(zR + y / rho, l, u),  y += rho (zR - zNext),  z = zNext
+  /// The last iteration first saves y for the certificate's dy.
+  virtual void iterate(int count) = 0;
+  virtual AdmmMeasures measure() = 0;
+  /// The current x, y and z (n x k, m x k, m x k).
+  virtual void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) = 0;
+};
+
+/// The ADMM control logic over a backend's kernels (see the file comment).
+class AdmmSolver {
+ public:
+  AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eigen::Index m, const AdmmSettings& settings);
+
+  /// Run from the warm starts x (n x k) and y (m x k) (zero if empty); on exit x, y and z
+  /// (m x k) hold the last iterate. Rows whose bounds are equal in every column are
+  /// equality rows. rho carries over from the previous solve; K changes only when the
+  /// equality pattern or rho changed.
+  AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                 Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
+
+  const AdmmSettings& settings() const { return settings_; }
+  double rho() const { return rho_; }
+
+ private:
+  std::unique_ptr<AdmmKernels> kernels_;
+  Eigen::Index n_;
+  Eigen::Index m_;
+  AdmmSettings settings_;
+  double rho_;
+  bool factored_ = false;
+  std::vector<char> factoredEquality_;
+  double factoredRho_ = 0.0;
+};
+
+/// The host kernels: the Eigen loop, solving with `backend.createSpdSolver` (a prefactored
+/// Cholesky on the CPU backend). The default of Backend::createAdmmSolver.
+std::unique_ptr<AdmmKernels> createHostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C,
+                                                   const AdmmSettings& settings);
+
+}  // namespace plano::compute

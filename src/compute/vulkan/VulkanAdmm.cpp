@@ -1,0 +1,409 @@
+#include "compute/vulkan/VulkanAdmm.h"
+
+#include <algorithm>
+#include <string>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+// Push constants of the kernels (layouts of the shaders' Push blocks).
+struct StepPush {
+  std::uint32_t n, m, slotRz, slotPq;
+};
+struct SpmvDotPush {
+  std::uint32_t n;
+};
+struct DirectionPush {
+  std::uint32_t n, m, slotNew, slotOld;
+};
+struct ReducePush {
+  std::uint32_t groups, m, slot;
+};
+struct ControlPush {
+  std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, pad0, pad1;
+  double tolerance2;
+};
+struct RhsPush {
+  std::uint32_t rows, count, mode, pad;
+  double sigma;
+};
+struct UpdatePush {
+  std::uint32_t m, count, saveDual, pad;
+  double alpha;
+};
+struct SupportPush {
+  std::uint32_t n;
+};
+struct AssemblePush {
+  std::uint32_t nonZeros, n;
+  double rho;
+};
+
+// PCG scalar slots (k values each).
+enum PcgSlot : std::uint32_t { kRzEven = 0, kRzOdd, kPq, kBz, kPcgSlots };
+// Check scalar slots (k values each), in AdmmMeasures' order.
+enum MeasureSlot : std::uint32_t {
+  kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
+};
+// pcg_control's state and its indirect arguments (byte offsets of the three triples).
+enum State : std::uint32_t { kDone = 0, kInnerIterations, kCappedSolves, kStateSize };
+constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24;
+
+std::uint32_t count32(Eigen::Index value, const char* what) {
+  if (value < 0 || value > 0x7fffffff) throwDevice(std::string("Vulkan ADMM: ") + what + " too large");
+  return static_cast<std::uint32_t>(value);
+}
+
+/// P + sigma I with explicit zeros wherever C^T C has an entry: the union pattern, so that
+/// K0 and K1 share one index layout and K = K0 + rho K1 is an entrywise sum.
+compute::SparseMatrix unionPatternK0(const compute::SparseMatrix& P, const compute::SparseMatrix& C, double sigma) {
+  if (P.rows() != P.cols() || C.cols() != P.rows()) {
+    throwUsage("ADMM: P is " + std::to_string(P.rows()) + "x" + std::to_string(P.cols()) + " and C is " +
+               std::to_string(C.rows()) + "x" + std::to_string(C.cols()) + " (need n x n and m x n)");
+  }
+  compute::SparseMatrix I(P.rows(), P.rows());
+  I.setIdentity();
+  const compute::SparseMatrix CtC = C.transpose() * C;
+  compute::SparseMatrix K0 = P + I * sigma + CtC * 0.0;
+  K0.makeCompressed();
+  return K0;
+}
+
+}  // namespace
+
+struct AdmmKernels::Workspace {
+  Workspace(Context& context, std::uint32_t n, std::uint32_t m, std::uint32_t k)
+      : k(k),
+        q(context, n, k, "ADMM q"),
+        x(context, n, k, "ADMM x"),
+        xTilde(context, n, k, "ADMM xTilde"),
+        rhs(context, n, k, "ADMM right-hand side"),
+        Ctw(context, n, k, "ADMM C^T (rho z - y)"),
+        r(context, n, k, "PCG residual"),
+        preconditioned(context, n, k, "PCG preconditioned residual"),
+        p(context, n, k, "PCG direction"),
+        Kp(context, n, k, "PCG K times direction"),
+        Px(context, n, k, "ADMM P x"),
+        Cty(context, n, k, "ADMM C^T y"),
+        Ctdy(context, n, k, "ADMM C^T dy"),
+        lower(context, m, k, "ADMM lower bounds"),
+        upper(context, m, k, "ADMM upper bounds"),
+        y(context, m, k, "ADMM y"),
+        yPrevious(context, m, k, "ADMM previous y"),
+        z(context, m, k, "ADMM z"),
+        zTilde(context, m, k, "ADMM zTilde"),
+        w(context, m, k, "ADMM rho z - y"),
+        Cx(context, m, k, "ADMM C x"),
+        dy(context, m, k, "ADMM dy"),
+        pcg(context, kPcgSlots, k, n),
+        measures(context, kMeasureSlots, k, std::max(n, m)),
+        state(context, kStateSize, MemoryClass::Device, "PCG control state"),
+        arguments(context, 9, MemoryClass::Device, "PCG indirect arguments"),
+        start(context),
+        check(context) {}
+  std::uint32_t k;
+  DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
+  DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
+  DeviceScalars pcg;
+  DeviceScalars measures;
+  Array<double> state;
+  Array<std::uint32_t> arguments;
+  // The inner PCG's descriptor sets, built once: a block records thousands of dispatches.
+  std::unique_ptr<DescriptorSet> spmvDotSet, reduceSet, stepSet, directionSet, controlSet;
+  Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
+  Sequence check;  ///< The inf-norms of AdmmMeasures.
+  /// Recorded blocks by 2 * iteration count + (first solve long).
+  std::map<int, std::unique_ptr<Sequence>> blocks;
+};
+
+AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
+                         const compute::AdmmSettings& settings)
+    : context_(context),
+      settings_(settings),
+      n_(count32(P.rows(), "n")),
+      m_(count32(C.rows(), "m")),
+      C_(C),
+      Ct_(C.transpose()),
+      K0_(unionPatternK0(P, C, settings.sigma)),
+      algebra_(context),
+      devP_(context, P),
+      devC_(context, C_),
+      devCt_(context, Ct_),
+      devK_(context, K0_),
+      k0Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K0 values"),
+      k1Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K1 values"),
+      diagonal_(context, n_, MemoryClass::Device, "ADMM K diagonal positions"),
+      inverseDiagonal_(context, n_, MemoryClass::Device, "ADMM inverse diagonal of K"),
+      rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
+      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(SpmvDotPush)),
+      step_(context, "pcg_step", 8, sizeof(StepPush)),
+      direction_(context, "pcg_direction", 3, sizeof(DirectionPush)),
+      reduce_(context, "la_reduce", 2, sizeof(ReducePush)),
+      control_(context, "pcg_control", 3, sizeof(ControlPush)),
+      rhs_(context, "admm_rhs", 4, sizeof(RhsPush)),
+      update_(context, "admm_update", 7, sizeof(UpdatePush)),
+      support_(context, "admm_support", 4, sizeof(SupportPush)),
+      assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
+      assembly_(context),
+      innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
+  C_.makeCompressed();
+  Ct_.makeCompressed();
+  diagonalIndex_.resize(n_);
+  for (std::uint32_t r = 0; r < n_; ++r) {
+    const int* begin = K0_.innerIndexPtr() + K0_.outerIndexPtr()[r];
+    const int* end = K0_.innerIndexPtr() + K0_.outerIndexPtr()[r + 1];
+    const int* found = std::lower_bound(begin, end, static_cast<int>(r));
+    diagonalIndex_[r] = static_cast<std::int32_t>(found - K0_.innerIndexPtr());
+  }
+  k0Values_.upload({K0_.valuePtr(), static_cast<std::size_t>(K0_.nonZeros())});
+  diagonal_.upload(diagonalIndex_);
+}
+
+AdmmKernels::~AdmmKernels() = default;
+
+void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
+  if (equality.size() != m_) throwUsage("ADMM: equality flags for " + std::to_string(equality.size()) + " rows");
+  if (K1_.size() == 0 || equality != equality_) {
+    Eigen::VectorXd D(m_);
+    for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
+    const compute::SparseMatrix CtDC = Ct_ * D.asDiagonal() * C_;
+    K1_ = CtDC + K0_ * 0.0;  // onto the union pattern
+    K1_.makeCompressed();
+    if (K1_.nonZeros() != K0_.nonZeros() ||
+        !std::equal(K0_.innerIndexPtr(), K0_.innerIndexPtr() + K0_.nonZeros(), K1_.innerIndexPtr()) ||
+        !std::equal(K0_.outerIndexPtr(), K0_.outerIndexPtr() + n_ + 1, K1_.outerIndexPtr())) {
+      throwDevice("Vulkan ADMM: K0 and K1 do not share one sparsity pattern");
+    }
+    k1Values_.upload({K1_.valuePtr(), static_cast<std::size_t>(K1_.nonZeros())});
+    equality_ = equality;
+  }
+  // The diagonal decides the Jacobi preconditioner; checking it here costs O(n) on the
+  // host and gives the same error as the SPD solvers.
+  for (std::uint32_t r = 0; r < n_; ++r) {
+    const double d = K0_.valuePtr()[diagonalIndex_[r]] + rho * K1_.valuePtr()[diagonalIndex_[r]];
+    if (!(d > 0.0)) {
+      throwNumerical("ADMM: diagonal entry of row " + std::to_string(r) + " of K is " + std::to_string(d) +
+                     " (a symmetric positive definite matrix has a positive diagonal)");
+    }
+  }
+  std::vector<double> rows(m_);
+  for (std::uint32_t i = 0; i < m_; ++i) rows[i] = equality[i] ? rho * settings_.equalityRhoScale : rho;
+  rhoRows_.upload(rows);
+  const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
+  assembly_.begin();
+  assembly_.dispatch(assemble_, {k0Values_, k1Values_, diagonal_, devK_.values(), inverseDiagonal_},
+                     AssemblePush{nonZeros, n_, rho}, groupsFor(context_, std::max(nonZeros, n_)));
+  assembly_.end();
+  assembly_.run();
+  longFirstSolve_ = true;
+}
+
+void AdmmKernels::prepare(std::uint32_t k) {
+  if (workspace_ && workspace_->k == k) return;
+  workspace_.reset();
+  workspace_ = std::make_unique<Workspace>(context_, n_, m_, k);
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+
+  w.spmvDotSet = std::make_unique<DescriptorSet>(
+      context_, spmvDot_,
+      std::initializer_list<BufferRange>{devK_.rowOffsets(), devK_.columns(), devK_.values(), w.p.data(),
+                                         w.Kp.data(), w.pcg.partial()});
+  w.reduceSet = std::make_unique<DescriptorSet>(context_, reduce_,
+                                                std::initializer_list<BufferRange>{w.pcg.partial(), w.pcg.values()});
+  w.stepSet = std::make_unique<DescriptorSet>(
+      context_, step_,
+      std::initializer_list<BufferRange>{w.p.data(), w.Kp.data(), w.xTilde.data(), w.r.data(),
+                                         w.preconditioned.data(), inverseDiagonal_, w.pcg.values(),
+                                         w.pcg.partial()});
+  w.directionSet = std::make_unique<DescriptorSet>(
+      context_, direction_, std::initializer_list<BufferRange>{w.preconditioned.data(), w.p.data(), w.pcg.values()});
+  w.controlSet = std::make_unique<DescriptorSet>(
+      context_, control_, std::initializer_list<BufferRange>{w.pcg.values(), w.state, w.arguments});
+
+  w.start.begin();
+  la.spmv(w.start, devC_, w.x, w.zTilde);
+  la.clamp(w.start, w.zTilde, w.lower, w.upper, w.z);
+  la.copy(w.start, w.x, w.xTilde);
+  la.copy(w.start, w.y, w.yPrevious);
+  w.start.end();
+
+  Sequence& s = w.check;
+  s.begin();
+  la.spmv(s, devC_, w.x, w.Cx);
+  la.spmv(s, devP_, w.x, w.Px);
+  la.spmv(s, devCt_, w.y, w.Cty);
+  la.maxAbs(s, w.Cx, -1.0, w.z, w.measures, kPrimal);
+  la.maxAbs(s, w.Px, 1.0, w.q, 1.0, w.Cty, w.measures, kDual);
+  la.maxAbs(s, w.Cx, w.measures, kCx);
+  la.maxAbs(s, w.z, w.measures, kZ);
+  la.maxAbs(s, w.Px, w.measures, kPx);
+  la.maxAbs(s, w.Cty, w.measures, kCty);
+  la.maxAbs(s, w.q, w.measures, kQ);
+  la.maxAbs(s, w.x, w.measures, kX);
+  la.maxAbs(s, w.y, w.measures, kY);
+  la.copy(s, w.y, w.dy);
+  la.axpby(s, -1.0, w.yPrevious, 1.0, w.dy);
+  la.maxAbs(s, w.dy, w.measures, kDy);
+  la.spmv(s, devCt_, w.dy, w.Ctdy);
+  la.maxAbs(s, w.Ctdy, w.measures, kCtdy);
+  s.dispatch(support_, {w.dy.data(), w.lower.data(), w.upper.data(), w.measures.partial()}, SupportPush{m_},
+             w.measures.groups(), k);
+  s.barrier();
+  la.reduce(s, w.measures, kSupport);
+  s.end();
+}
+
+void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations) {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  const std::uint32_t k = w.k;
+  const std::uint32_t mk = m_ * k;
+  const std::uint32_t nk = n_ * k;
+
+  // rhs = sigma x - q + C^T (rho z - y)
+  s.dispatch(rhs_, {w.z.data(), w.y.data(), rhoRows_, w.w.data()}, RhsPush{m_, mk, 0, 0, settings_.sigma},
+             groupsFor(context_, mk));
+  s.barrier();
+  la.spmv(s, devCt_, w.w, w.Ctw);
+  s.dispatch(rhs_, {w.x.data(), w.q.data(), w.Ctw.data(), w.rhs.data()}, RhsPush{n_, nk, 1, 0, settings_.sigma},
+             groupsFor(context_, nk));
+  s.barrier();
+
+  // PCG start from xTilde: r = rhs - K xTilde, preconditioned = M^-1 r, p = it, r.z, b.z.
+  la.spmv(s, devK_, w.xTilde, w.Kp);
+  la.copy(s, w.rhs, w.r);
+  la.axpby(s, -1.0, w.Kp, 1.0, w.r);
+  la.scaleRows(s, inverseDiagonal_, w.r, w.preconditioned);
+  la.copy(s, w.preconditioned, w.p);
+  la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
+  la.scaleRows(s, inverseDiagonal_, w.rhs, w.Kp);  // Kp as scratch for M^-1 b
+  la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
+
+  const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
+  const std::uint32_t groups = w.pcg.groups();
+  const std::uint32_t directionGroups = groupsFor(context_, nk);
+  auto control = [&](std::uint32_t mode, std::uint32_t slot) {
+    s.dispatch(control_, *w.controlSet, ControlPush{k, slot, kBz, mode, groups, directionGroups, 0, 0, tolerance2}, 1);
+    s.barrier();
+  };
+  control(0, kRzEven);
+  for (int j = 0; j < innerIterations; ++j) {
+    // The iteration of vk::PcgSolver; r.z alternates between two slots.
+    const std::uint32_t current = j % 2 == 0 ? kRzEven : kRzOdd;
+    const std::uint32_t next = j % 2 == 0 ? kRzOdd : kRzEven;
+    s.dispatchIndirect(spmvDot_, *w.spmvDotSet, SpmvDotPush{n_}, w.arguments, kFusedArguments);
+    s.barrier();
+    s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
+    s.barrier();
+    s.dispatchIndirect(step_, *w.stepSet, StepPush{n_, k, current, kPq}, w.arguments, kFusedArguments);
+    s.barrier();
+    s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kReduceArguments);
+    s.barrier();
+    s.dispatchIndirect(direction_, *w.directionSet, DirectionPush{n_, k, next, current}, w.arguments,
+                       kDirectionArguments);
+    s.barrier();
+    control(j + 1 == innerIterations ? 2 : 1, next);
+  }
+
+  // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
+  const double alpha = settings_.relaxation;
+  la.spmv(s, devC_, w.xTilde, w.zTilde);
+  la.axpby(s, alpha, w.xTilde, 1.0 - alpha, w.x);
+  s.dispatch(update_,
+             {w.zTilde.data(), w.z.data(), w.y.data(), w.yPrevious.data(), w.lower.data(), w.upper.data(), rhoRows_},
+             UpdatePush{m_, mk, saveDual ? 1u : 0u, 0, alpha}, groupsFor(context_, mk));
+  s.barrier();
+}
+
+Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
+  Workspace& w = *workspace_;
+  auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
+  if (!slot) {
+    const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+    slot = std::make_unique<Sequence>(context_);
+    slot->begin();
+    for (int i = 0; i < count; ++i) {
+      recordIteration(*slot, i == count - 1, i == 0 && longFirstSolve ? largest : innerIterations_);
+    }
+    slot->end();
+  }
+  return *slot;
+}
+
+void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                        const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+  const auto k = count32(q.cols(), "k");
+  if (k == 0) {  // nothing to iterate; measure() reports empty norms
+    workspace_.reset();
+    return;
+  }
+  prepare(k);
+  Workspace& w = *workspace_;
+  w.q.upload(q);
+  w.lower.upload(lower);
+  w.upper.upload(upper);
+  w.x.upload(x);
+  w.y.upload(y);
+  const double zeros[kStateSize] = {0.0, 0.0, 0.0};
+  w.state.upload(zeros);
+  cappedSolves_ = 0;
+  longFirstSolve_ = true;
+  w.start.run();
+}
+
+void AdmmKernels::iterate(int count) {
+  if (!workspace_ || count <= 0) return;
+  block(count, longFirstSolve_).run();
+  longFirstSolve_ = false;
+}
+
+compute::AdmmMeasures AdmmKernels::measure() {
+  compute::AdmmMeasures s;
+  if (!workspace_) return s;
+  Workspace& w = *workspace_;
+  w.check.run();
+  const std::vector<double> all = w.measures.read();
+  auto slot = [&](std::uint32_t index) {
+    Eigen::VectorXd v(w.k);
+    for (std::uint32_t c = 0; c < w.k; ++c) v[c] = w.measures.at(all, index, c);
+    return v;
+  };
+  s.primalResidual = slot(kPrimal);
+  s.dualResidual = slot(kDual);
+  s.Cx = slot(kCx);
+  s.z = slot(kZ);
+  s.Px = slot(kPx);
+  s.Cty = slot(kCty);
+  s.q = slot(kQ);
+  s.x = slot(kX);
+  s.y = slot(kY);
+  s.dy = slot(kDy);
+  s.Ctdy = slot(kCtdy);
+  s.support = slot(kSupport);
+  double state[kStateSize];
+  w.state.download(state);
+  s.linearIterations = static_cast<long>(state[kInnerIterations]);
+  s.inexactSolves = static_cast<long>(state[kCappedSolves]);
+  const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+  if (s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
+    innerIterations_ = std::min(2 * innerIterations_, largest);
+    w.blocks.clear();  // re-recorded with the new cap on their next use
+  }
+  cappedSolves_ = s.inexactSolves;
+  return s;
+}
+
+void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
+  if (!workspace_) {
+    z.resize(m_, 0);
+    return;
+  }
+  workspace_->x.download(x);
+  workspace_->y.download(y);
+  workspace_->z.download(z);
+}
+
+}  // namespace plano::vk

@@ -1,0 +1,86 @@
+#pragma once
+// The ADMM iteration of compute/Admm.h on the device. P, C and C^T are uploaded once; x,
+// y, z and the problem data stay on the device for a whole solve, and between two checks
+// one recorded command buffer runs the checkInterval iterations: only the check's
+// per-column inf-norms (a few dozen doubles) come back.
+//
+// K = P + sigma I + C^T diag(rho) C: rho takes two values (rho, rho * equalityRhoScale on
+// equality rows), so K = K0 + rho K1 with K0 = P + sigma I and K1 = C^T D C (D = 1 or
+// equalityRhoScale), both stored on the union sparsity pattern; a rho update is one
+// kernel (values and Jacobi diagonal), with no host refactorization. K1 is rebuilt on the
+// host only when the equality pattern changes.
+//
+// Inner solve: K xTilde = rhs by Jacobi PCG warm-started from the previous xTilde. The
+// iterations are recorded (a cap per ADMM iteration) and sized through
+// indirect dispatches by a one-thread control kernel (shaders/pcg_control.comp): once
+// every column has r.z <= tol^2 b.z the remaining recorded iterations are empty
+// dispatches. So each solve stops at the tolerance, like a host-driven PCG, without a
+// read-back. A solve that needs more than the cap continues from its warm start in the
+// next ADMM iteration (an inexact ADMM step, counted in AdmmInfo::inexactSolves); when a
+// check sees one, the cap doubles for the following blocks (re-recorded), up to
+// kMaxInnerIterations. The first iteration after start() or a rho update, whose warm
+// start is the poorest, always gets kMaxInnerIterations. A fixed count without the flag would either waste work or stop
+// short on every solve.
+#include <map>
+#include <memory>
+
+#include "compute/Admm.h"
+#include "compute/vulkan/VulkanLinearAlgebra.h"
+
+namespace plano::vk {
+
+class AdmmKernels final : public compute::AdmmKernels {
+ public:
+  /// Recorded PCG iterations per ADMM iteration: the first cap, and the largest it grows
+  /// to. Warm-started solves of consecutive ADMM iterations usually need far fewer; the
+  /// cap bounds the recording's size (empty dispatches are not free).
+  static constexpr int kInitialInnerIterations = 256;
+  static constexpr int kMaxInnerIterations = 1024;
+
+  /// Upload P (n x n), C (m x n) and C^T. Throws Error(Device) when a buffer exceeds the device.
+  AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
+              const compute::AdmmSettings& settings);
+  ~AdmmKernels() override;
+
+  void setRho(const std::vector<char>& equality, double rho) override;
+  void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+             const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
+  void iterate(int count) override;
+  compute::AdmmMeasures measure() override;
+  void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
+
+ private:
+  struct Workspace;  // vectors, scalars and recorded sequences for one column count k
+  void prepare(std::uint32_t k);
+  Sequence& block(int count, bool longFirstSolve);
+  void recordIteration(Sequence& s, bool saveDual, int innerIterations);
+
+  Context& context_;
+  compute::AdmmSettings settings_;
+  std::uint32_t n_;
+  std::uint32_t m_;
+  compute::SparseMatrix C_;
+  compute::SparseMatrix Ct_;
+  compute::SparseMatrix K0_;         ///< P + sigma I on the union pattern (host copy).
+  compute::SparseMatrix K1_;         ///< C^T D C on the union pattern (host copy).
+  std::vector<char> equality_;       ///< Rows of K1_'s D = equalityRhoScale.
+  std::vector<std::int32_t> diagonalIndex_;
+  LinearAlgebra algebra_;
+  DeviceCsrMatrix devP_;
+  DeviceCsrMatrix devC_;
+  DeviceCsrMatrix devCt_;
+  DeviceCsrMatrix devK_;              ///< Values rewritten by every rho update.
+  Array<double> k0Values_;
+  Array<double> k1Values_;
+  Array<std::int32_t> diagonal_;
+  Array<double> inverseDiagonal_;
+  Array<double> rhoRows_;            ///< rho per constraint row.
+  Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_;
+  Sequence assembly_;
+  int innerIterations_;              ///< The current cap.
+  long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
+  bool longFirstSolve_ = true;       ///< The next block starts after start() or setRho().
+  std::unique_ptr<Workspace> workspace_;
+};
+
+}  // namespace plano::vk
