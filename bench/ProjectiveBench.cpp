@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "MemoryCounters.h"
+#include "VulkanBenchSupport.h"
 #include "compute/Backend.h"
 #include "mesh/Generators.h"
 #include "projective/Deformation.h"
@@ -16,15 +18,6 @@ namespace {
 
 using plano::Index;
 using plano::compute::BackendChoice;
-
-std::unique_ptr<plano::compute::Backend> backendOrSkip(benchmark::State& state, BackendChoice choice) {
-  try {
-    return plano::compute::createBackend(choice);
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return nullptr;
-  }
-}
 
 plano::PolygonMesh grid(benchmark::State& state) {
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(state.range(0)))));
@@ -48,8 +41,9 @@ plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
 }
 
 void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
-  auto backend = backendOrSkip(state, choice);
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const plano::projective::ShapeSpace space(mesh);
   const plano::Positions target = perspectiveTarget(space);
@@ -63,8 +57,9 @@ void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:
 /// a global step that needs real ADMM work.
 void BM_GlobalStep(benchmark::State& state, BackendChoice choice) {
-  auto backend = backendOrSkip(state, choice);
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const plano::projective::ShapeSpace space(mesh);
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
@@ -91,8 +86,9 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice) {
 
 /// One as-rigid-as-possible iteration: fixed row, corner handle lifted.
 void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
-  auto backend = backendOrSkip(state, choice);
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
   plano::PositionalConstraints constraints;
