@@ -33,7 +33,7 @@ FaceFrame fitFaceFrame(const Positions& Y, std::span<const Index> face, Index f,
   frame.centroid = P.colwise().mean().transpose();
   P.rowwise() -= frame.centroid.transpose();
   if (!P.allFinite()) throwBadInput("face " + std::to_string(f) + " has a non-finite corner");
-  Eigen::JacobiSVD<Eigen::MatrixX3d> svd(P, Eigen::ComputeThinV);
+  Eigen::JacobiSVD<Eigen::MatrixX3d> svd(P, Eigen::ComputeFullV);  // thin V needs a dynamic column count
   const Eigen::Vector3d s = svd.singularValues();
   frame.flatness = s[0] > 0.0 ? s[1] / s[0] : 0.0;
   frame.nonPlanarity = s[0] > 0.0 ? s[2] / s[0] : 0.0;
