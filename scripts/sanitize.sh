@@ -5,8 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 BUILD_DIR=${PLANO_SANITIZE_BUILD_DIR:-build-sanitize}
-# -O1 with line tables only: a quicker build than -O2 -g, with stack traces
-# that still name file and line.
+# -O1 with line tables only: a quicker build than -O2 -g, with stack traces that still name
+# file and line. No NDEBUG: Eigen's and nlohmann-json's assertions are checked as well.
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DPLANO_SANITIZE=ON -DPLANO_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)" --target plano plano_tests

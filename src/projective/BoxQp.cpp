@@ -10,23 +10,6 @@
 namespace plano::projective {
 namespace {
 
-compute::AdmmSettings admmSettings(const BoxQpSettings& s) {
-  compute::AdmmSettings a;
-  a.rho = s.rho;
-  a.equalityRhoScale = s.equalityRhoScale;
-  a.sigma = s.sigma;
-  a.relaxation = s.relaxation;
-  a.absoluteTolerance = s.absoluteTolerance;
-  a.relativeTolerance = s.relativeTolerance;
-  a.infeasibilityTolerance = s.infeasibilityTolerance;
-  a.maxIterations = s.maxIterations;
-  a.checkInterval = s.checkInterval;
-  a.adaptiveRho = s.adaptiveRho;
-  a.adaptiveRhoFactor = s.adaptiveRhoFactor;
-  a.linearSolver = s.linearSolver;
-  return a;
-}
-
 BoxQpStatus toBoxQpStatus(compute::AdmmStatus status) {
   switch (status) {
     case compute::AdmmStatus::Solved: return BoxQpStatus::Solved;
@@ -69,7 +52,7 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
     throwUsage("box QP: P is " + std::to_string(P_.rows()) + "x" + std::to_string(P_.cols()) + " and C is " +
                std::to_string(C_.rows()) + "x" + std::to_string(C_.cols()) + " (need n x n and m x n)");
   }
-  admm_ = backend_.createAdmmSolver(P_, C_, admmSettings(settings_));
+  admm_ = backend_.createAdmmSolver(P_, C_, static_cast<const compute::AdmmSettings&>(settings_));
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,

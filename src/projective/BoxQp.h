@@ -22,22 +22,11 @@
 
 namespace plano::projective {
 
-struct BoxQpSettings {
-  double rho = 0.1;                  ///< Initial ADMM penalty of inequality rows.
-  double equalityRhoScale = 1e3;     ///< rho of rows with l = u, relative to rho.
-  double sigma = 1e-6;               ///< Proximal term: keeps K definite for a PSD P.
-  double relaxation = 1.6;           ///< Over-relaxation alpha in (0, 2).
-  double absoluteTolerance = 1e-6;   ///< eps_abs of the primal and dual residuals (inf-norms).
-  double relativeTolerance = 1e-6;   ///< eps_rel, relative to the sizes of the terms.
-  double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
-  int maxIterations = 4000;
-  int checkInterval = 10;            ///< Residuals and certificates every this many iterations.
-  bool adaptiveRho = true;
-  double adaptiveRhoFactor = 5.0;    ///< Refactor only when rho moves by more than this factor.
+/// The ADMM's settings (compute::AdmmSettings) and those of the final polish.
+struct BoxQpSettings : compute::AdmmSettings {
   bool polish = true;
   int polishIterations = 30;         ///< Max method-of-multipliers refinements of the polish.
   double polishRho = 1e9;            ///< Penalty of the polish's equality system.
-  compute::LinearSolverSettings linearSolver;
 };
 
 enum class BoxQpStatus {

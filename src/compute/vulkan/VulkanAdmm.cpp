@@ -3,21 +3,13 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/PcgPushConstants.h"
 #include "core/Error.h"
 
 namespace plano::vk {
 namespace {
 
-// Push constants of the kernels (layouts of the shaders' Push blocks).
-struct StepPush {
-  std::uint32_t n, m, slotRz, slotPq;
-};
-struct SpmvDotPush {
-  std::uint32_t n;
-};
-struct DirectionPush {
-  std::uint32_t n, m, slotNew, slotOld;
-};
+// Push constants of the ADMM kernels (layouts of the shaders' Push blocks).
 struct ReducePush {
   std::uint32_t groups, m, slot;
 };
@@ -137,9 +129,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       diagonal_(context, n_, MemoryClass::Device, "ADMM K diagonal positions"),
       inverseDiagonal_(context, n_, MemoryClass::Device, "ADMM inverse diagonal of K"),
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
-      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(SpmvDotPush)),
-      step_(context, "pcg_step", 8, sizeof(StepPush)),
-      direction_(context, "pcg_direction", 3, sizeof(DirectionPush)),
+      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
+      step_(context, "pcg_step", 8, sizeof(PcgStepPush)),
+      direction_(context, "pcg_direction", 3, sizeof(PcgDirectionPush)),
       reduce_(context, "la_reduce", 2, sizeof(ReducePush)),
       control_(context, "pcg_control", 3, sizeof(ControlPush)),
       rhs_(context, "admm_rhs", 4, sizeof(RhsPush)),
@@ -294,15 +286,15 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
     // The iteration of vk::PcgSolver; r.z alternates between two slots.
     const std::uint32_t current = j % 2 == 0 ? kRzEven : kRzOdd;
     const std::uint32_t next = j % 2 == 0 ? kRzOdd : kRzEven;
-    s.dispatchIndirect(spmvDot_, *w.spmvDotSet, SpmvDotPush{n_}, w.arguments, kFusedArguments);
+    s.dispatchIndirect(spmvDot_, *w.spmvDotSet, PcgSpmvDotPush{n_}, w.arguments, kFusedArguments);
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
     s.barrier();
-    s.dispatchIndirect(step_, *w.stepSet, StepPush{n_, k, current, kPq}, w.arguments, kFusedArguments);
+    s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq}, w.arguments, kFusedArguments);
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kReduceArguments);
     s.barrier();
-    s.dispatchIndirect(direction_, *w.directionSet, DirectionPush{n_, k, next, current}, w.arguments,
+    s.dispatchIndirect(direction_, *w.directionSet, PcgDirectionPush{n_, k, next, current}, w.arguments,
                        kDirectionArguments);
     s.barrier();
     control(j + 1 == innerIterations ? 2 : 1, next);

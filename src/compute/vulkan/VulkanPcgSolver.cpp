@@ -3,20 +3,12 @@
 #include <cmath>
 #include <string>
 
+#include "compute/vulkan/PcgPushConstants.h"
 #include "core/Error.h"
 
 namespace plano::vk {
 namespace {
 
-struct StepPush {
-  std::uint32_t n, m, slotRz, slotPq;
-};
-struct SpmvDotPush {
-  std::uint32_t n;
-};
-struct DirectionPush {
-  std::uint32_t n, m, slotNew, slotOld;
-};
 
 // Scalar slots (one value per column each).
 enum Slot : std::uint32_t { kRzEven = 0, kRzOdd, kPq, kRr, kBb, kSlots };
@@ -72,9 +64,9 @@ PcgSolver::PcgSolver(Context& context, const compute::SparseMatrix& A, const com
       algebra_(context),
       matrix_(context, A),
       inverseDiagonal_(context, n_, MemoryClass::Device, "inverse diagonal"),
-      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(SpmvDotPush)),
-      step_(context, "pcg_step", 8, sizeof(StepPush)),
-      direction_(context, "pcg_direction", 3, sizeof(DirectionPush)) {
+      spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
+      step_(context, "pcg_step", 8, sizeof(PcgStepPush)),
+      direction_(context, "pcg_direction", 3, sizeof(PcgDirectionPush)) {
   inverseDiagonal_.upload(inverseDiagonalOf(A));
 }
 
@@ -113,17 +105,17 @@ void PcgSolver::prepare(std::uint32_t m) {
     w.block.dispatch(spmvDot_,
                      {matrix_.rowOffsets(), matrix_.columns(), matrix_.values(), w.p.data(), w.q.data(),
                       w.scalars.partial()},
-                     SpmvDotPush{n_}, w.scalars.groups(), m);
+                     PcgSpmvDotPush{n_}, w.scalars.groups(), m);
     w.block.barrier();
     la.reduce(w.block, w.scalars, kPq);
     w.block.dispatch(step_,
                      {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseDiagonal_,
                       w.scalars.values(), w.scalars.partial()},
-                     StepPush{n_, m, current, kPq}, w.scalars.groups(), m);
+                     PcgStepPush{n_, m, current, kPq}, w.scalars.groups(), m);
     w.block.barrier();
     la.reduce(w.block, w.scalars, next);
     w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},
-                     DirectionPush{n_, m, next, current}, groupsFor(context_, count));
+                     PcgDirectionPush{n_, m, next, current}, groupsFor(context_, count));
     w.block.barrier();
   }
   la.dot(w.block, w.r, w.r, w.scalars, kRr);
