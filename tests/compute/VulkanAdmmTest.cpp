@@ -20,6 +20,7 @@
 #include "mesh/Generators.h"
 #include "projective/GlobalStep.h"
 #include "projective/ShapeSpace.h"
+#include "support/CpuForwardingBackend.h"
 
 namespace plano::test {
 namespace {
@@ -211,23 +212,9 @@ class RecordingKernels final : public compute::AdmmKernels {
   BoxQp& record_;
 };
 
-class RecordingBackend final : public compute::Backend {
+class RecordingBackend final : public CpuForwardingBackend {
  public:
-  compute::BackendKind kind() const override { return compute::BackendKind::Cpu; }
   std::string name() const override { return "cpu, recording QPs"; }
-  void facePlanarity(const PolygonMesh& mesh, std::span<double> out) override { cpu_.facePlanarity(mesh, out); }
-  void fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
-                         compute::ProjectiveFits& out) override {
-    cpu_.fitProjectiveMaps(faces, source, target, out);
-  }
-  void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
-                        std::span<Eigen::Vector3d> singularValues) override {
-    cpu_.closestRotations(matrices, rotations, singularValues);
-  }
-  std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
-                                                      const compute::LinearSolverSettings& settings) override {
-    return cpu_.createSpdSolver(A, settings);
-  }
   std::unique_ptr<compute::AdmmSolver> createAdmmSolver(const compute::SparseMatrix& P, const compute::SparseMatrix& C,
                                                         const compute::AdmmSettings& settings) override {
     qp.P = P;
@@ -239,9 +226,6 @@ class RecordingBackend final : public compute::Backend {
   }
   BoxQp qp;
   compute::AdmmSettings settingsUsed;
-
- private:
-  compute::CpuBackend cpu_;
 };
 
 /// Conflicting rigid targets on a grid with its first row fixed: a global step with real

@@ -10,6 +10,7 @@
 #include "mesh/Generators.h"
 #include "planarize/Planarize.h"
 #include "planarize/PlanarizeTestMeshes.h"
+#include "support/CpuForwardingBackend.h"
 #include "support/TestMeshes.h"
 
 namespace plano::planarize {
@@ -43,28 +44,15 @@ class ConjugateGradientSolver final : public compute::SpdSolver {
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg_;
 };
 
-class IterativeSolverBackend final : public compute::Backend {
+class IterativeSolverBackend final : public test::CpuForwardingBackend {
  public:
-  compute::BackendKind kind() const override { return compute::BackendKind::Cpu; }
   std::string name() const override { return "cpu with conjugate gradients"; }
-  void facePlanarity(const PolygonMesh& mesh, std::span<double> out) override { cpu_.facePlanarity(mesh, out); }
-  void fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
-                         compute::ProjectiveFits& out) override {
-    cpu_.fitProjectiveMaps(faces, source, target, out);
-  }
-  void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
-                        std::span<Eigen::Vector3d> singularValues) override {
-    cpu_.closestRotations(matrices, rotations, singularValues);
-  }
   std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
                                                       const compute::LinearSolverSettings&) override {
     ++solversCreated;
     return std::make_unique<ConjugateGradientSolver>(A);
   }
   int solversCreated = 0;
-
- private:
-  compute::CpuBackend cpu_;
 };
 
 void expectAgreement(const PolygonMesh& mesh, const Settings& settings, compute::Backend& other) {
