@@ -17,6 +17,7 @@
 #include "compute/MeshMatrices.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
 #include "mesh/Generators.h"
 #include "projective/GlobalStep.h"
 #include "projective/ShapeSpace.h"
@@ -26,6 +27,18 @@ namespace plano::test {
 namespace {
 
 class VulkanAdmm : public VulkanTest {};
+
+/// The device recordings every comparison runs: the multi-dispatch PCG, the
+/// single-workgroup kernel with its own budget, and the same kernel resuming after every
+/// unit of work (so that a block spans hundreds of dispatches).
+struct Recording {
+  const char* name;
+  vk::AdmmRecording recording;
+  std::uint32_t unitsPerDispatch;
+};
+constexpr Recording kRecordings[] = {{"multi-dispatch", vk::AdmmRecording::MultiDispatch, 0},
+                                     {"single workgroup", vk::AdmmRecording::SingleWorkgroup, 0}};
+constexpr Recording kResumingEveryUnit{"single workgroup, one unit per dispatch", vk::AdmmRecording::SingleWorkgroup, 1};
 
 struct BoxQp {
   compute::SparseMatrix P, C;
@@ -41,6 +54,26 @@ compute::AdmmSettings tightSettings() {
   compute::AdmmSettings settings;
   settings.linearSolver.relativeTolerance = 1e-12;
   return settings;
+}
+
+std::unique_ptr<compute::AdmmSolver> deviceSolver(vk::Context& context, const BoxQp& qp,
+                                                 const compute::AdmmSettings& settings, const Recording& recording) {
+  return std::make_unique<compute::AdmmSolver>(
+      std::make_unique<vk::AdmmKernels>(context, qp.P, qp.C, settings, recording.recording, recording.unitsPerDispatch),
+      qp.P.rows(), qp.C.rows(), settings);
+}
+
+AdmmRun runAdmm(compute::AdmmSolver& solver, const BoxQp& qp) {
+  AdmmRun run;
+  run.x = qp.x;
+  run.y = qp.y;
+  run.info = solver.solve(qp.q, qp.lower, qp.upper, run.x, run.y, run.z);
+  return run;
+}
+
+AdmmRun runAdmm(vk::Context& context, const BoxQp& qp, const compute::AdmmSettings& settings,
+                const Recording& recording) {
+  return runAdmm(*deviceSolver(context, qp, settings, recording), qp);
 }
 
 AdmmRun runAdmm(compute::Backend& backend, const BoxQp& qp, const compute::AdmmSettings& settings) {
@@ -91,7 +124,9 @@ void expectAgreement(const AdmmRun& device, const AdmmRun& host, const compute::
                std::to_string(device.info.linearIterations));
   EXPECT_EQ(device.info.status, host.info.status);
   EXPECT_LE(std::abs(device.info.iterations - host.info.iterations), settings.checkInterval);
-  if (sameRhoHistory) EXPECT_EQ(device.info.factorizations, host.info.factorizations);
+  if (sameRhoHistory) {
+    EXPECT_EQ(device.info.factorizations, host.info.factorizations);
+  }
   // Inner solves stopped by the recorded cap are allowed (the cap grows after them), but
   // they stay a small fraction of the solves.
   EXPECT_LE(device.info.inexactSolves, device.info.iterations / 3);
@@ -106,11 +141,14 @@ TEST_F(VulkanAdmm, RandomBoxQpsGiveTheHostIterates) {
     SCOPED_TRACE(seed);
     const BoxQp qp = randomBoxQp(60, 45, seed);
     const AdmmRun host = runAdmm(cpu, qp, settings);
-    const AdmmRun device = runAdmm(backend(), qp, settings);
     ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
     EXPECT_GT(host.info.iterations, settings.checkInterval);
-    expectAgreement(device, host, settings, 1e-8);
-    EXPECT_GT(device.info.linearIterations, 0);
+    for (const Recording& recording : kRecordings) {
+      SCOPED_TRACE(recording.name);
+      const AdmmRun device = runAdmm(context(), qp, settings, recording);
+      expectAgreement(device, host, settings, 1e-8);
+      EXPECT_GT(device.info.linearIterations, 0);
+    }
   }
 }
 
@@ -120,19 +158,22 @@ TEST_F(VulkanAdmm, RhoUpdatesAndWarmStartsCarryOverLikeTheHost) {
   compute::AdmmSettings settings = tightSettings();
   settings.rho = 1e-4;  // far from balanced: forces rho updates
   const BoxQp qp = randomBoxQp(50, 40, 7);
-  auto hostSolver = cpu.createAdmmSolver(qp.P, qp.C, settings);
-  auto deviceSolver = backend().createAdmmSolver(qp.P, qp.C, settings);
-  AdmmRun host, device;
-  host.info = hostSolver->solve(qp.q, qp.lower, qp.upper, host.x, host.y, host.z);
-  device.info = deviceSolver->solve(qp.q, qp.lower, qp.upper, device.x, device.y, device.z);
-  EXPECT_GT(host.info.factorizations, 1);
-  expectAgreement(device, host, settings, 1e-8);
-  EXPECT_NEAR(deviceSolver->rho(), hostSolver->rho(), 1e-5 * hostSolver->rho());
-  const Eigen::MatrixXd q2 = qp.q * 1.1;
-  host.info = hostSolver->solve(q2, qp.lower, qp.upper, host.x, host.y, host.z);
-  device.info = deviceSolver->solve(q2, qp.lower, qp.upper, device.x, device.y, device.z);
-  expectAgreement(device, host, settings, 1e-8);
-  EXPECT_LT(relativeDifference(device.z, host.z), 1e-8);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    auto hostSolver = cpu.createAdmmSolver(qp.P, qp.C, settings);
+    auto device = deviceSolver(context(), qp, settings, recording);
+    AdmmRun hostRun, deviceRun;
+    hostRun.info = hostSolver->solve(qp.q, qp.lower, qp.upper, hostRun.x, hostRun.y, hostRun.z);
+    deviceRun.info = device->solve(qp.q, qp.lower, qp.upper, deviceRun.x, deviceRun.y, deviceRun.z);
+    EXPECT_GT(hostRun.info.factorizations, 1);
+    expectAgreement(deviceRun, hostRun, settings, 1e-8);
+    EXPECT_NEAR(device->rho(), hostSolver->rho(), 1e-5 * hostSolver->rho());
+    const Eigen::MatrixXd q2 = qp.q * 1.1;
+    hostRun.info = hostSolver->solve(q2, qp.lower, qp.upper, hostRun.x, hostRun.y, hostRun.z);
+    deviceRun.info = device->solve(q2, qp.lower, qp.upper, deviceRun.x, deviceRun.y, deviceRun.z);
+    expectAgreement(deviceRun, hostRun, settings, 1e-8);
+    EXPECT_LT(relativeDifference(deviceRun.z, hostRun.z), 1e-8);
+  }
 }
 
 TEST_F(VulkanAdmm, EqualityOnlyProblemGivesTheHostSolution) {
@@ -141,10 +182,13 @@ TEST_F(VulkanAdmm, EqualityOnlyProblemGivesTheHostSolution) {
   BoxQp qp = randomBoxQp(60, 20, 11);
   qp.upper = qp.lower;  // every row an equality
   const AdmmRun host = runAdmm(cpu, qp, settings);
-  const AdmmRun device = runAdmm(backend(), qp, settings);
   ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
-  expectAgreement(device, host, settings, 1e-8);
-  EXPECT_LT((qp.C * device.x - qp.lower).cwiseAbs().maxCoeff(), 1e-4);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun device = runAdmm(context(), qp, settings, recording);
+    expectAgreement(device, host, settings, 1e-8);
+    EXPECT_LT((qp.C * device.x - qp.lower).cwiseAbs().maxCoeff(), 1e-4);
+  }
 }
 
 TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
@@ -167,10 +211,13 @@ TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
   compute::CpuBackend cpu;
   compute::AdmmSettings settings;
   const AdmmRun host = runAdmm(cpu, qp, settings);
-  const AdmmRun device = runAdmm(backend(), qp, settings);
   EXPECT_EQ(host.info.status, compute::AdmmStatus::PrimalInfeasible);
-  EXPECT_EQ(device.info.status, compute::AdmmStatus::PrimalInfeasible);
-  EXPECT_LE(std::abs(device.info.iterations - host.info.iterations), settings.checkInterval);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun device = runAdmm(context(), qp, settings, recording);
+    EXPECT_EQ(device.info.status, compute::AdmmStatus::PrimalInfeasible);
+    EXPECT_LE(std::abs(device.info.iterations - host.info.iterations), settings.checkInterval);
+  }
 }
 
 TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
@@ -179,10 +226,53 @@ TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
   compute::CpuBackend cpu;
   compute::AdmmSettings settings;
   const AdmmRun host = runAdmm(cpu, qp, settings);
-  const AdmmRun device = runAdmm(backend(), qp, settings);
   EXPECT_EQ(host.info.status, compute::AdmmStatus::NonFinite);
-  EXPECT_EQ(device.info.status, compute::AdmmStatus::NonFinite);
-  EXPECT_EQ(device.info.iterations, settings.checkInterval);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun device = runAdmm(context(), qp, settings, recording);
+    EXPECT_EQ(device.info.status, compute::AdmmStatus::NonFinite);
+    EXPECT_EQ(device.info.iterations, settings.checkInterval);
+  }
+}
+
+TEST_F(VulkanAdmm, ResumingAfterEveryUnitOfWorkChangesNothing) {
+  // The single-workgroup kernel saves and restores its position between dispatches; the
+  // arithmetic is the same in the same order, so the iterates are bit for bit the same.
+  const BoxQp qp = randomBoxQp(24, 18, 4);
+  const compute::AdmmSettings settings = tightSettings();
+  const AdmmRun whole = runAdmm(context(), qp, settings, kRecordings[1]);
+  const AdmmRun resumed = runAdmm(context(), qp, settings, kResumingEveryUnit);
+  ASSERT_EQ(whole.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(resumed.info.status, whole.info.status);
+  EXPECT_EQ(resumed.info.iterations, whole.info.iterations);
+  EXPECT_EQ(resumed.info.linearIterations, whole.info.linearIterations);
+  EXPECT_GT(whole.info.linearIterations, whole.info.iterations) << "solves of more than one PCG iteration";
+  EXPECT_EQ(resumed.x, whole.x);
+  EXPECT_EQ(resumed.y, whole.y);
+}
+
+TEST_F(VulkanAdmm, SmallProblemsRunInOneWorkgroupAndWideOnesRefuseIt) {
+  const BoxQp qp = randomBoxQp(40, 30, 3);
+  const compute::AdmmSettings settings;
+  vk::AdmmKernels automatic(context(), qp.P, qp.C, settings);
+  automatic.setRho(std::vector<char>(30, 0), 0.1);
+  automatic.start(qp.q, qp.lower, qp.upper, Eigen::MatrixXd::Zero(40, 3), Eigen::MatrixXd::Zero(30, 3));
+  EXPECT_TRUE(automatic.singleWorkgroup());
+
+  // Five columns exceed the kernel's four: automatic falls back, forced throws.
+  const Eigen::MatrixXd q = Eigen::MatrixXd::Zero(40, 5), bounds = Eigen::MatrixXd::Zero(30, 5);
+  const Eigen::MatrixXd x = Eigen::MatrixXd::Zero(40, 5), y = Eigen::MatrixXd::Zero(30, 5);
+  automatic.start(q, bounds, bounds, x, y);
+  EXPECT_FALSE(automatic.singleWorkgroup());
+  vk::AdmmKernels forced(context(), qp.P, qp.C, settings, vk::AdmmRecording::SingleWorkgroup);
+  forced.setRho(std::vector<char>(30, 0), 0.1);
+  try {
+    forced.start(q, bounds, bounds, x, y);
+    ADD_FAILURE() << "five columns were accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device);
+    EXPECT_NE(std::string(e.what()).find("columns"), std::string::npos) << e.what();
+  }
 }
 
 // --- A real global-step QP, captured from a CPU global step ------------------------------
@@ -261,10 +351,13 @@ TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
   compute::AdmmSettings settings = recorder.settingsUsed;
   settings.linearSolver.relativeTolerance = 1e-12;
   const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
-  const AdmmRun device = runAdmm(backend(), recorder.qp, settings);
   ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
   EXPECT_GT(host.info.iterations, settings.checkInterval);
-  expectAgreement(device, host, settings, 1e-5, false);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun device = runAdmm(context(), recorder.qp, settings, recording);
+    expectAgreement(device, host, settings, 1e-5, false);
+  }
 }
 
 TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {

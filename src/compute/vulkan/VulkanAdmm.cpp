@@ -4,6 +4,7 @@
 #include <string>
 
 #include "compute/vulkan/PcgPushConstants.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -28,6 +29,10 @@ struct UpdatePush {
 struct SupportPush {
   std::uint32_t n;
 };
+struct SingleWorkgroupPush {
+  std::uint32_t n, m, k, iterations, cap, budget, begin, pad;
+  double sigma, alpha, tolerance2;
+};
 struct AssemblePush {
   std::uint32_t nonZeros, n;
   double rho;
@@ -40,7 +45,23 @@ enum MeasureSlot : std::uint32_t {
   kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
 };
 // pcg_control's state and its indirect arguments (byte offsets of the three triples).
-enum State : std::uint32_t { kDone = 0, kInnerIterations, kCappedSolves, kStateSize };
+// pcg_control's state, then the resumable position of admm_single_workgroup.
+enum State : std::uint32_t {
+  kDone = 0, kInnerIterations, kCappedSolves, kRemaining, kPhase, kSolveIterations, kStateRz,
+  kStateBz = kStateRz + AdmmKernels::kSingleWorkgroupColumns,
+  kStateSize = kStateBz + AdmmKernels::kSingleWorkgroupColumns
+};
+// llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
+// single-workgroup kernel's budget keeps its estimate below half of that.
+constexpr std::uint64_t kCpuLoopBackEdges = 32768;
+// On GPUs the budget only keeps one dispatch short (well under a second).
+constexpr std::uint32_t kGpuUnitsPerDispatch = 4096;
+
+bool isCpuDevice(const Context& context) { return context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+
+/// The single-workgroup kernel's size: on CPU devices every invocation pays for every
+/// barrier, so fewer; on GPUs more lanes sweep the rows.
+std::uint32_t singleWorkgroupSize(const Context& context) { return isCpuDevice(context) ? 64 : 256; }
 constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24;
 
 std::uint32_t count32(Eigen::Index value, const char* what) {
@@ -96,6 +117,10 @@ struct AdmmKernels::Workspace {
         start(context),
         check(context) {}
   std::uint32_t k;
+  bool singleWorkgroup = false;
+  std::uint32_t budget = 0;                  ///< Units of work per single-workgroup dispatch.
+  double expectedInnerIterations = 16.0;     ///< Per solve, from the last block (sizes recordings).
+  std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
   DeviceScalars pcg;
@@ -103,7 +128,7 @@ struct AdmmKernels::Workspace {
   Array<double> state;
   Array<std::uint32_t> arguments;
   // The inner PCG's descriptor sets, built once: a block records thousands of dispatches.
-  std::unique_ptr<DescriptorSet> spmvDotSet, reduceSet, stepSet, directionSet, controlSet;
+  std::unique_ptr<DescriptorSet> spmvDotSet, reduceSet, stepSet, directionSet, controlSet, singleWorkgroupSet;
   Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
   Sequence check;  ///< The inf-norms of AdmmMeasures.
   /// Recorded blocks by 2 * iteration count + (first solve long).
@@ -111,7 +136,8 @@ struct AdmmKernels::Workspace {
 };
 
 AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
-                         const compute::AdmmSettings& settings)
+                         const compute::AdmmSettings& settings, AdmmRecording recording,
+                         std::uint32_t unitsPerDispatch)
     : context_(context),
       settings_(settings),
       n_(count32(P.rows(), "n")),
@@ -129,6 +155,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       diagonal_(context, n_, MemoryClass::Device, "ADMM K diagonal positions"),
       inverseDiagonal_(context, n_, MemoryClass::Device, "ADMM inverse diagonal of K"),
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
+      recording_(recording),
+      unitsPerDispatch_(unitsPerDispatch),
       spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
       step_(context, "pcg_step", 8, sizeof(PcgStepPush)),
       direction_(context, "pcg_direction", 3, sizeof(PcgDirectionPush)),
@@ -138,6 +166,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       update_(context, "admm_update", 7, sizeof(UpdatePush)),
       support_(context, "admm_support", 4, sizeof(SupportPush)),
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
+      singleWorkgroup_(context, "admm_single_workgroup", kSingleWorkgroupBuffers, sizeof(SingleWorkgroupPush),
+                       singleWorkgroupSize(context)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
@@ -192,11 +222,64 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   longFirstSolve_ = true;
 }
 
+namespace {
+
+std::uint64_t longestRow(const compute::SparseMatrix& A) {
+  std::uint64_t longest = 0;
+  for (Eigen::Index r = 0; r < A.outerSize(); ++r) {
+    longest = std::max<std::uint64_t>(longest, A.outerIndexPtr()[r + 1] - A.outerIndexPtr()[r]);
+  }
+  return longest;
+}
+
+}  // namespace
+
+std::uint32_t AdmmKernels::singleWorkgroupBudget(std::uint32_t k) const {
+  if (unitsPerDispatch_ > 0) return unitsPerDispatch_;
+  if (!isCpuDevice(context_)) return kGpuUnitsPerDispatch;
+  // Loop back-edges of one invocation per unit of work (shaders/admm_single_workgroup.comp),
+  // bounded from above: rows per invocation times the longest rows, plus the reductions.
+  const std::uint64_t group = singleWorkgroupSize(context_), parts = group / kSingleWorkgroupColumns;
+  const std::uint64_t columns = k + 1, maxK = longestRow(K0_) + 1;
+  const std::uint64_t reduction = columns * (parts + 2) + group / parts + 2;
+  const std::uint64_t rows = (n_ + group - 1) / group, constraintRows = (m_ + group - 1) / group;
+  const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 1) + 2 * reduction;
+  const std::uint64_t pcg = rows * columns * (maxK + 3) + 2 * reduction + 4 * kSingleWorkgroupColumns;
+  const std::uint64_t update = constraintRows * columns * (longestRow(C_) + 2) + rows * columns;
+  const std::uint64_t unit = std::max({start, pcg, update}) + 4;
+  const std::uint64_t fixed = 8 * kSingleWorkgroupColumns;
+  return kCpuLoopBackEdges > fixed + unit ? static_cast<std::uint32_t>((kCpuLoopBackEdges - fixed) / unit) : 0;
+}
+
+bool AdmmKernels::useSingleWorkgroup(std::uint32_t k) const {
+  const bool fits = k <= kSingleWorkgroupColumns &&
+                    context_.info().maxStorageBuffersPerStage >= kSingleWorkgroupBuffers &&
+                    singleWorkgroupBudget(k) > 0;
+  switch (recording_) {
+    case AdmmRecording::MultiDispatch: return false;
+    case AdmmRecording::Automatic: return fits && n_ <= kSingleWorkgroupUnknowns;
+    case AdmmRecording::SingleWorkgroup:
+      if (!fits) {
+        throwDevice("Vulkan ADMM: the single-workgroup kernel needs at most " +
+                    std::to_string(kSingleWorkgroupColumns) + " columns (got " + std::to_string(k) + "), " +
+                    std::to_string(kSingleWorkgroupBuffers) + " storage buffers per stage (device offers " +
+                    std::to_string(context_.info().maxStorageBuffersPerStage) +
+                    ") and, on a CPU device, rows short enough for its loop limit");
+      }
+      return true;
+  }
+  return false;
+}
+
+bool AdmmKernels::singleWorkgroup() const { return workspace_ && workspace_->singleWorkgroup; }
+
 void AdmmKernels::prepare(std::uint32_t k) {
   if (workspace_ && workspace_->k == k) return;
   workspace_.reset();
   workspace_ = std::make_unique<Workspace>(context_, n_, m_, k);
   Workspace& w = *workspace_;
+  w.singleWorkgroup = useSingleWorkgroup(k);
+  if (w.singleWorkgroup) w.budget = singleWorkgroupBudget(k);
   LinearAlgebra& la = algebra_;
 
   w.spmvDotSet = std::make_unique<DescriptorSet>(
@@ -214,6 +297,15 @@ void AdmmKernels::prepare(std::uint32_t k) {
       context_, direction_, std::initializer_list<BufferRange>{w.preconditioned.data(), w.p.data(), w.pcg.values()});
   w.controlSet = std::make_unique<DescriptorSet>(
       context_, control_, std::initializer_list<BufferRange>{w.pcg.values(), w.state, w.arguments});
+  if (w.singleWorkgroup) {
+    w.singleWorkgroupSet = std::make_unique<DescriptorSet>(
+        context_, singleWorkgroup_,
+        std::initializer_list<BufferRange>{
+            devK_.rowOffsets(), devK_.columns(), devK_.values(), inverseDiagonal_, devC_.rowOffsets(),
+            devC_.columns(), devC_.values(), devCt_.rowOffsets(), devCt_.columns(), devCt_.values(), w.q.data(),
+            w.x.data(), w.xTilde.data(), w.r.data(), w.preconditioned.data(), w.p.data(), w.Kp.data(),
+            w.lower.data(), w.upper.data(), w.y.data(), w.yPrevious.data(), w.z.data(), rhoRows_, w.state});
+  }
 
   w.start.begin();
   la.spmv(w.start, devC_, w.x, w.zTilde);
@@ -310,6 +402,57 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
   s.barrier();
 }
 
+void AdmmKernels::recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin) {
+  Workspace& w = *workspace_;
+  const double tolerance = settings_.linearSolver.relativeTolerance;
+  const auto cap = static_cast<std::uint32_t>(std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations)));
+  const DescriptorSet& set = *w.singleWorkgroupSet;
+  for (int d = 0; d < dispatches; ++d) {
+    const SingleWorkgroupPush push{n_,    m_,    w.k, static_cast<std::uint32_t>(count), cap, w.budget,
+                                   begin && d == 0 ? 1u : 0u, 0, settings_.sigma, settings_.relaxation,
+                                   tolerance * tolerance};
+    s.dispatch(singleWorkgroup_, set, push, 1);
+    s.barrier();
+  }
+}
+
+void AdmmKernels::iterateSingleWorkgroup(int count) {
+  Workspace& w = *workspace_;
+  // Dispatches for the expected work (each solve: a start, its PCG iterations, the
+  // updates), rounded up to a power of two so that few recordings are kept. A dispatch
+  // after the block is done returns at once; a block that needs more resumes below.
+  const double units = count * (w.expectedInnerIterations + 2.0);
+  int dispatches = 1;
+  while (dispatches < 4096 && dispatches * static_cast<double>(w.budget) < units) dispatches *= 2;
+  auto& first = w.blocks[count * 8192 + dispatches];
+  if (!first) {
+    first = std::make_unique<Sequence>(context_);
+    first->begin();
+    recordSingleWorkgroup(*first, count, dispatches, true);
+    first->end();
+  }
+  const double innerBefore = stateValue(kInnerIterations);
+  first->run();
+  while (stateValue(kRemaining) > 0.0) {
+    throwIfCancelled("the ADMM iteration");
+    auto& resume = w.resumes[dispatches];
+    if (!resume) {
+      resume = std::make_unique<Sequence>(context_);
+      resume->begin();
+      recordSingleWorkgroup(*resume, count, dispatches, false);
+      resume->end();
+    }
+    resume->run();
+  }
+  w.expectedInnerIterations = std::max(1.0, (stateValue(kInnerIterations) - innerBefore) / count);
+}
+
+double AdmmKernels::stateValue(std::uint32_t slot) {
+  double state[kStateSize];
+  workspace_->state.download(state);
+  return state[slot];
+}
+
 Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
@@ -339,7 +482,7 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   w.upper.upload(upper);
   w.x.upload(x);
   w.y.upload(y);
-  const double zeros[kStateSize] = {0.0, 0.0, 0.0};
+  const double zeros[kStateSize] = {};
   w.state.upload(zeros);
   cappedSolves_ = 0;
   longFirstSolve_ = true;
@@ -348,6 +491,10 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
 
 void AdmmKernels::iterate(int count) {
   if (!workspace_ || count <= 0) return;
+  if (workspace_->singleWorkgroup) {
+    iterateSingleWorkgroup(count);
+    return;
+  }
   block(count, longFirstSolve_).run();
   longFirstSolve_ = false;
 }
@@ -380,7 +527,7 @@ compute::AdmmMeasures AdmmKernels::measure() {
   s.linearIterations = static_cast<long>(state[kInnerIterations]);
   s.inexactSolves = static_cast<long>(state[kCappedSolves]);
   const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
-  if (s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
+  if (!w.singleWorkgroup && s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
     innerIterations_ = std::min(2 * innerIterations_, largest);
     w.blocks.clear();  // re-recorded with the new cap on their next use
   }

@@ -21,6 +21,12 @@
 // kMaxInnerIterations. The first iteration after start() or a rho update, whose warm
 // start is the poorest, always gets kMaxInnerIterations. A fixed count without the flag would either waste work or stop
 // short on every solve.
+//
+// Small problems take another recording of the same iteration: the whole block between
+// two checks is one dispatch of one workgroup (shaders/admm_single_workgroup.comp), which
+// loops over the ADMM and PCG iterations itself. There a dispatch costs more than the
+// arithmetic it carries, and the multi-dispatch recording pays six per PCG iteration,
+// most of them empty. Its inner solve stops at the tolerance or at kMaxInnerIterations.
 #include <map>
 #include <memory>
 
@@ -29,6 +35,13 @@
 
 namespace plano::vk {
 
+/// How the iterations between two checks are recorded.
+enum class AdmmRecording {
+  Automatic,        ///< SingleWorkgroup when the problem is small enough, else MultiDispatch.
+  SingleWorkgroup,  ///< One dispatch per block (throws Error(Device) where it cannot run).
+  MultiDispatch,    ///< Kernels over the whole device, PCG sized by indirect dispatches.
+};
+
 class AdmmKernels final : public compute::AdmmKernels {
  public:
   /// Recorded PCG iterations per ADMM iteration: the first cap, and the largest it grows
@@ -36,10 +49,19 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// cap bounds the recording's size (empty dispatches are not free).
   static constexpr int kInitialInnerIterations = 256;
   static constexpr int kMaxInnerIterations = 1024;
+  /// Automatic recording uses one workgroup up to this many unknowns per column: one
+  /// workgroup then sweeps a vector in at most a few hundred rows per invocation.
+  static constexpr std::uint32_t kSingleWorkgroupUnknowns = 1u << 16;
+  /// Columns and storage buffers of the single-workgroup kernel.
+  static constexpr std::uint32_t kSingleWorkgroupColumns = 4;
+  static constexpr std::uint32_t kSingleWorkgroupBuffers = 24;
 
   /// Upload P (n x n), C (m x n) and C^T. Throws Error(Device) when a buffer exceeds the device.
+  /// `unitsPerDispatch` > 0 overrides the single-workgroup kernel's work per dispatch
+  /// (tests use 1 to make every block resume many times).
   AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
-              const compute::AdmmSettings& settings);
+              const compute::AdmmSettings& settings, AdmmRecording recording = AdmmRecording::Automatic,
+              std::uint32_t unitsPerDispatch = 0);
   ~AdmmKernels() override;
 
   void setRho(const std::vector<char>& equality, double rho) override;
@@ -47,6 +69,8 @@ class AdmmKernels final : public compute::AdmmKernels {
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
   void iterate(int count) override;
   compute::AdmmMeasures measure() override;
+  /// Whether the current workspace (after start()) records one dispatch per block.
+  bool singleWorkgroup() const;
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
 
  private:
@@ -54,6 +78,11 @@ class AdmmKernels final : public compute::AdmmKernels {
   void prepare(std::uint32_t k);
   Sequence& block(int count, bool longFirstSolve);
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);
+  void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
+  void iterateSingleWorkgroup(int count);
+  double stateValue(std::uint32_t slot);
+  std::uint32_t singleWorkgroupBudget(std::uint32_t k) const;
+  bool useSingleWorkgroup(std::uint32_t k) const;
 
   Context& context_;
   compute::AdmmSettings settings_;
@@ -75,7 +104,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   Array<std::int32_t> diagonal_;
   Array<double> inverseDiagonal_;
   Array<double> rhoRows_;            ///< rho per constraint row.
-  Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_;
+  AdmmRecording recording_;
+  std::uint32_t unitsPerDispatch_;
+  Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.

@@ -277,6 +277,7 @@ void Context::choosePhysicalDevice() {
   info_.shaderFloat64 = chosen->features.shaderFloat64;
   info_.shaderInt64 = chosen->features.shaderInt64;
   info_.maxStorageBufferRange = limits.maxStorageBufferRange;
+  info_.maxStorageBuffersPerStage = limits.maxPerStageDescriptorStorageBuffers;
   for (int d = 0; d < 3; ++d) {
     info_.maxWorkGroupCount[d] = limits.maxComputeWorkGroupCount[d];
     if (settings_.maxWorkGroups > 0) info_.maxWorkGroupCount[d] = std::min(info_.maxWorkGroupCount[d], settings_.maxWorkGroups);

@@ -50,6 +50,7 @@ struct DeviceInfo {
   bool shaderFloat64 = false;
   bool shaderInt64 = false;
   std::uint32_t maxStorageBufferRange = 0;
+  std::uint32_t maxStorageBuffersPerStage = 0;  ///< Storage buffers one kernel may bind.
   std::uint32_t maxWorkGroupCount[3] = {0, 0, 0};  ///< Lowered by ContextSettings::maxWorkGroups.
   std::uint32_t maxWorkGroupInvocations = 0;
   std::uint32_t maxSharedMemoryBytes = 0;

@@ -9,7 +9,7 @@
 namespace plano::vk {
 
 Pipeline::Pipeline(Context& context, std::string_view shader, std::uint32_t bindingCount,
-                   std::uint32_t pushConstantBytes)
+                   std::uint32_t pushConstantBytes, std::uint32_t workGroupSize)
     : context_(context), name_(shader), bindingCount_(bindingCount), pushConstantBytes_(pushConstantBytes) {
   const std::span<const std::uint32_t> code = embeddedShader(shader);
   if (code.empty()) throwDevice("Vulkan: shader '" + name_ + "' is not embedded in this build");
@@ -45,6 +45,9 @@ Pipeline::Pipeline(Context& context, std::string_view shader, std::uint32_t bind
     pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     pipelineInfo.stage.module = module;
     pipelineInfo.stage.pName = "main";
+    const VkSpecializationMapEntry sizeEntry{0, 0, sizeof(std::uint32_t)};
+    const VkSpecializationInfo specialization{1, &sizeEntry, sizeof(workGroupSize), &workGroupSize};
+    if (workGroupSize > 0) pipelineInfo.stage.pSpecializationInfo = &specialization;
     pipelineInfo.layout = layout_;
     const VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_);
     vkDestroyShaderModule(device, module, nullptr);

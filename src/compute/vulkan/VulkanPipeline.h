@@ -16,7 +16,10 @@ class Pipeline {
  public:
   /// Build the pipeline of shaders/<shader>.comp. Throws Error(Device) when the shader
   /// is not embedded or the driver rejects it.
-  Pipeline(Context& context, std::string_view shader, std::uint32_t bindingCount, std::uint32_t pushConstantBytes);
+  /// `workGroupSize` > 0 sets the shader's local_size_x_id = 0 specialization constant
+  /// (for kernels whose best workgroup size depends on the device).
+  Pipeline(Context& context, std::string_view shader, std::uint32_t bindingCount, std::uint32_t pushConstantBytes,
+           std::uint32_t workGroupSize = 0);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;

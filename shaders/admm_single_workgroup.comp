@@ -1,0 +1,257 @@
+#version 450
+// A whole block of ADMM iterations (the work between two convergence checks) in as few
+// dispatches as possible of ONE workgroup: right-hand side, the inner Jacobi-PCG solve
+// with its tolerance test, the x, z and y updates, all looped inside the kernel. The same
+// iteration as the multi-dispatch path (admm_rhs, pcg_*, admm_update; see VulkanAdmm.h),
+// for problems small enough that one workgroup sweeps them quickly: there, a dispatch
+// costs more than the arithmetic it carries (lavapipe: ~10 us each, six per PCG
+// iteration), and this kernel replaces thousands of them by a few.
+//
+// The kernel is resumable: it runs at most `budget` units of work (one unit: the start of
+// a solve, one PCG iteration, or the final updates), then saves where it stopped in
+// `state` and returns; the next dispatch goes on from there, and one whose block is done
+// returns at once. A budget is needed because llvmpipe (lavapipe) silently ends every loop
+// of an invocation once all its loops together took 65535 back-edges; the host sizes the
+// budget below that (and for GPUs, to keep one dispatch short).
+//
+// Every n-sized vector entry (row i, column c) is owned by invocation i % GROUP: it is
+// the only one that writes it, so row-local updates need no synchronization. Only the
+// vectors read across rows (p in K p, xTilde in C xTilde, z and y in C^T (rho z - y))
+// need a buffer barrier after they are written. Dot products reduce in shared memory.
+// Vectors are column-major (n x k or m x k).
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+// The workgroup size is chosen by the host (a multiple of MAX_COLUMNS): small on CPU
+// devices, where every invocation pays for every barrier, large on GPUs.
+layout(local_size_x_id = 0) in;
+#define GROUP gl_WorkGroupSize.x
+#define MAX_COLUMNS 4
+#define PARTS (GROUP / MAX_COLUMNS)
+
+layout(std430, binding = 0) readonly buffer KRows { int kRows[]; };
+layout(std430, binding = 1) readonly buffer KColumns { int kColumns[]; };
+layout(std430, binding = 2) readonly buffer KValues { double kValues[]; };
+layout(std430, binding = 3) readonly buffer InverseDiagonal { double inverseDiagonal[]; };
+layout(std430, binding = 4) readonly buffer CRows { int cRows[]; };
+layout(std430, binding = 5) readonly buffer CColumns { int cColumns[]; };
+layout(std430, binding = 6) readonly buffer CValues { double cValues[]; };
+layout(std430, binding = 7) readonly buffer CtRows { int ctRows[]; };
+layout(std430, binding = 8) readonly buffer CtColumns { int ctColumns[]; };
+layout(std430, binding = 9) readonly buffer CtValues { double ctValues[]; };
+layout(std430, binding = 10) readonly buffer Q { double q[]; };
+layout(std430, binding = 11) buffer X { double x[]; };
+layout(std430, binding = 12) coherent buffer XTilde { double xTilde[]; };
+layout(std430, binding = 13) buffer R { double r[]; };
+layout(std430, binding = 14) buffer Zp { double zp[]; };  // preconditioned residual
+layout(std430, binding = 15) coherent buffer P { double p[]; };
+layout(std430, binding = 16) buffer Kp { double kp[]; };
+layout(std430, binding = 17) readonly buffer Lower { double lower[]; };
+layout(std430, binding = 18) readonly buffer Upper { double upper[]; };
+layout(std430, binding = 19) coherent buffer Y { double y[]; };
+layout(std430, binding = 20) writeonly buffer YPrevious { double yPrevious[]; };
+layout(std430, binding = 21) coherent buffer Z { double z[]; };
+layout(std430, binding = 22) readonly buffer Rho { double rho[]; };
+// [1] inner iterations run, [2] solves stopped by the cap (as pcg_control's state), then
+// the resumable position: ADMM iterations left in the block, phase (0: next unit starts a
+// solve, 1: inside the PCG), PCG iterations of the current solve, r.z and b.z per column.
+layout(std430, binding = 23) buffer State { double state[]; };
+#define STATE_INNER 1
+#define STATE_CAPPED 2
+#define STATE_REMAINING 3
+#define STATE_PHASE 4
+#define STATE_SOLVE_ITERATIONS 5
+#define STATE_RZ 6
+#define STATE_BZ (STATE_RZ + MAX_COLUMNS)
+
+layout(push_constant) uniform Push {
+  uint n;
+  uint m;
+  uint k;           // columns, at most MAX_COLUMNS
+  uint iterations;  // ADMM iterations of the block; the last saves y to yPrevious
+  uint cap;         // PCG iterations per solve
+  uint budget;      // units of work of this dispatch
+  uint begin;       // 1: this dispatch starts the block (else it resumes from state)
+  uint pad;
+  double sigma;
+  double alpha;       // over-relaxation
+  double tolerance2;  // PCG stops when r.z <= tolerance2 * b.z in every column
+} pc;
+
+shared double sums[MAX_COLUMNS][GROUP];
+shared double parts[MAX_COLUMNS][PARTS];
+
+// Sum every column's per-invocation values over the workgroup; all invocations get the
+// totals. Two levels (PARTS partial sums, then every invocation adds those) cost two
+// barriers instead of a tree's log2(GROUP). The next reduce may start at once: its writes
+// to sums follow this one's last barrier, and its writes to parts its own first.
+void reduce(inout double value[MAX_COLUMNS]) {
+  const uint lane = gl_LocalInvocationID.x;
+  for (uint c = 0; c < pc.k; ++c) sums[c][lane] = value[c];
+  barrier();
+  const uint chunk = GROUP / PARTS;
+  if (lane < PARTS * pc.k) {
+    const uint c = lane / PARTS;
+    const uint first = (lane % PARTS) * chunk;
+    double sum = 0.0;
+    for (uint t = 0; t < chunk; ++t) sum += sums[c][first + t];
+    parts[c][lane % PARTS] = sum;
+  }
+  barrier();
+  for (uint c = 0; c < pc.k; ++c) {
+    double sum = 0.0;
+    for (uint t = 0; t < PARTS; ++t) sum += parts[c][t];
+    value[c] = sum;
+  }
+}
+
+// Make this invocation's buffer writes visible to the others, and wait for all.
+void synchronize() {
+  memoryBarrierBuffer();
+  barrier();
+}
+
+void main() {
+  const uint lane = gl_LocalInvocationID.x;
+  const uint n = pc.n;
+  const uint m = pc.m;
+  uint remaining = pc.begin != 0 ? pc.iterations : uint(state[STATE_REMAINING]);
+  uint phase = pc.begin != 0 ? 0 : uint(state[STATE_PHASE]);
+  uint j = uint(state[STATE_SOLVE_ITERATIONS]);
+  double rz[MAX_COLUMNS], bz[MAX_COLUMNS];
+  for (uint c = 0; c < MAX_COLUMNS; ++c) {
+    rz[c] = state[STATE_RZ + c];
+    bz[c] = state[STATE_BZ + c];
+  }
+  barrier();  // every invocation has read the state before lane 0 may rewrite it
+  uint innerIterations = 0;
+  uint cappedSolves = 0;
+  uint budget = pc.budget;
+  while (remaining > 0 && budget > 0) {
+    --budget;
+    if (phase == 0) {
+      // rhs = sigma x - q + C^T (rho z - y); PCG start from xTilde: r = rhs - K xTilde,
+      // zp = M^-1 r, p = zp, and the dot products r.zp and rhs.M^-1 rhs.
+      for (uint c = 0; c < MAX_COLUMNS; ++c) {
+        rz[c] = 0.0;
+        bz[c] = 0.0;
+      }
+      for (uint i = lane; i < n; i += GROUP) {
+        for (uint c = 0; c < pc.k; ++c) {
+          double ctw = 0.0;
+          for (int e = ctRows[i]; e < ctRows[i + 1]; ++e) {
+            const uint row = uint(ctColumns[e]);
+            precise double w = rho[row] * z[c * m + row] - y[c * m + row];
+            ctw += ctValues[e] * w;
+          }
+          precise double rhs = (pc.sigma * x[c * n + i] - q[c * n + i]) + ctw;
+          double product = 0.0;
+          for (int e = kRows[i]; e < kRows[i + 1]; ++e) product += kValues[e] * xTilde[c * n + uint(kColumns[e])];
+          const double ri = rhs - product;
+          const double zi = inverseDiagonal[i] * ri;
+          r[c * n + i] = ri;
+          zp[c * n + i] = zi;
+          p[c * n + i] = zi;
+          rz[c] += ri * zi;
+          bz[c] += rhs * (inverseDiagonal[i] * rhs);
+        }
+      }
+      reduce(rz);
+      reduce(bz);
+      synchronize();  // p
+      phase = 1;
+      j = 0;
+      continue;
+    }
+
+    bool running = false;
+    for (uint c = 0; c < pc.k; ++c) {
+      if (!(rz[c] <= pc.tolerance2 * bz[c])) running = true;  // NaN keeps running into the iterate
+    }
+    if (running && j < pc.cap) {
+      ++j;
+      ++innerIterations;
+      // Kp = K p and p.Kp
+      double pq[MAX_COLUMNS];
+      for (uint c = 0; c < MAX_COLUMNS; ++c) pq[c] = 0.0;
+      for (uint i = lane; i < n; i += GROUP) {
+        for (uint c = 0; c < pc.k; ++c) {
+          double product = 0.0;
+          for (int e = kRows[i]; e < kRows[i + 1]; ++e) product += kValues[e] * p[c * n + uint(kColumns[e])];
+          kp[c * n + i] = product;
+          pq[c] += p[c * n + i] * product;
+        }
+      }
+      reduce(pq);
+      // xTilde += a p, r -= a Kp, zp = M^-1 r, and the new r.zp. A converged column
+      // (r = 0) gives p.Kp = 0: it stands still instead of dividing by zero.
+      double rzNext[MAX_COLUMNS];
+      for (uint c = 0; c < MAX_COLUMNS; ++c) rzNext[c] = 0.0;
+      for (uint i = lane; i < n; i += GROUP) {
+        for (uint c = 0; c < pc.k; ++c) {
+          const double a = pq[c] != 0.0 ? rz[c] / pq[c] : 0.0;
+          xTilde[c * n + i] += a * p[c * n + i];
+          const double ri = r[c * n + i] - a * kp[c * n + i];
+          const double zi = inverseDiagonal[i] * ri;
+          r[c * n + i] = ri;
+          zp[c * n + i] = zi;
+          rzNext[c] += ri * zi;
+        }
+      }
+      reduce(rzNext);
+      // Every invocation has read p across rows (K p) before the reduces' barriers, so p
+      // can be overwritten now.
+      for (uint i = lane; i < n; i += GROUP) {
+        for (uint c = 0; c < pc.k; ++c) {
+          const double beta = rz[c] != 0.0 ? rzNext[c] / rz[c] : 0.0;
+          p[c * n + i] = zp[c * n + i] + beta * p[c * n + i];
+        }
+      }
+      for (uint c = 0; c < pc.k; ++c) rz[c] = rzNext[c];
+      synchronize();  // p
+      continue;
+    }
+    if (running) ++cappedSolves;
+    synchronize();  // xTilde
+
+    // zTilde = C xTilde (row by row, not stored), then z and y (OSQP Algorithm 1 steps
+    // 4-6, rho per row) and x = alpha xTilde + (1 - alpha) x.
+    const bool saveDual = remaining == 1;
+    for (uint row = lane; row < m; row += GROUP) {
+      for (uint c = 0; c < pc.k; ++c) {
+        double zTilde = 0.0;
+        for (int e = cRows[row]; e < cRows[row + 1]; ++e) zTilde += cValues[e] * xTilde[c * n + uint(cColumns[e])];
+        const uint index = c * m + row;
+        const double rhoRow = rho[row];
+        const double yi = y[index];
+        precise double zRelaxed = pc.alpha * zTilde + (1.0 - pc.alpha) * z[index];
+        precise double shifted = zRelaxed + (1.0 / rhoRow) * yi;
+        const double zNext = min(max(shifted, lower[index]), upper[index]);
+        precise double yNext = yi + rhoRow * (zRelaxed - zNext);
+        if (saveDual) yPrevious[index] = yi;
+        y[index] = yNext;
+        z[index] = zNext;
+      }
+    }
+    for (uint i = lane; i < n; i += GROUP) {
+      for (uint c = 0; c < pc.k; ++c) {
+        precise double xi = pc.alpha * xTilde[c * n + i] + (1.0 - pc.alpha) * x[c * n + i];
+        x[c * n + i] = xi;
+      }
+    }
+    synchronize();  // z and y
+    --remaining;
+    phase = 0;
+  }
+  if (lane == 0) {
+    state[STATE_INNER] += double(innerIterations);
+    state[STATE_CAPPED] += double(cappedSolves);
+    state[STATE_REMAINING] = double(remaining);
+    state[STATE_PHASE] = double(phase);
+    state[STATE_SOLVE_ITERATIONS] = double(j);
+    for (uint c = 0; c < MAX_COLUMNS; ++c) {
+      state[STATE_RZ + c] = rz[c];
+      state[STATE_BZ + c] = bz[c];
+    }
+  }
+}
