@@ -1,6 +1,6 @@
 #version 450
 // A whole block of ADMM iterations (the work between two convergence checks) in as few
-// dispatches as possible of ONE workgroup: right-hand side, the inner Jacobi-PCG solve
+// dispatches as possible of ONE workgroup: right-hand side, the inner block-Jacobi PCG solve
 // with its tolerance test, the x, z and y updates, all looped inside the kernel. The same
 // iteration as the multi-dispatch path (admm_rhs, pcg_*, admm_update; see VulkanAdmm.h),
 // for problems small enough that one workgroup sweeps them quickly: there, a dispatch
@@ -14,8 +14,9 @@
 // of an invocation once all its loops together took 65535 back-edges; the host sizes the
 // budget below that (and for GPUs, to keep one dispatch short).
 //
-// Every n-sized vector entry (row i, column c) is owned by invocation i % GROUP: it is
-// the only one that writes it, so row-local updates need no synchronization. Only the
+// The unknowns come in preconditioner blocks of b rows; every n-sized vector entry (row i,
+// column c) is owned by invocation (i / b) % GROUP: it is the only one that writes it, so
+// block-local updates need no synchronization. Only the
 // vectors read across rows (p in K p, xTilde in C xTilde, z and y in C^T (rho z - y))
 // need a buffer barrier after they are written. Dot products reduce in shared memory.
 // Vectors are column-major (n x k or m x k).
@@ -28,11 +29,13 @@ layout(local_size_x_id = 0) in;
 #define GROUP gl_WorkGroupSize.x
 #define MAX_COLUMNS 4
 #define PARTS (GROUP / MAX_COLUMNS)
+#define MAX_BLOCK 4
 
 layout(std430, binding = 0) readonly buffer KRows { int kRows[]; };
 layout(std430, binding = 1) readonly buffer KColumns { int kColumns[]; };
 layout(std430, binding = 2) readonly buffer KValues { double kValues[]; };
-layout(std430, binding = 3) readonly buffer InverseDiagonal { double inverseDiagonal[]; };
+// n / b dense b x b inverse blocks of K (row-major): the block-Jacobi preconditioner.
+layout(std430, binding = 3) readonly buffer InverseBlocks { double inverseBlocks[]; };
 layout(std430, binding = 4) readonly buffer CRows { int cRows[]; };
 layout(std430, binding = 5) readonly buffer CColumns { int cColumns[]; };
 layout(std430, binding = 6) readonly buffer CValues { double cValues[]; };
@@ -72,7 +75,7 @@ layout(push_constant) uniform Push {
   uint cap;         // PCG iterations per solve
   uint budget;      // units of work of this dispatch
   uint begin;       // 1: this dispatch starts the block (else it resumes from state)
-  uint pad;
+  uint b;           // preconditioner block size: divides n, at most MAX_BLOCK
   double sigma;
   double alpha;       // over-relaxation
   double tolerance2;  // PCG stops when r.z <= tolerance2 * b.z in every column
@@ -115,6 +118,7 @@ void main() {
   const uint lane = gl_LocalInvocationID.x;
   const uint n = pc.n;
   const uint m = pc.m;
+  const uint blocks = n / pc.b;
   uint remaining = pc.begin != 0 ? pc.iterations : uint(state[STATE_REMAINING]);
   uint phase = pc.begin != 0 ? 0 : uint(state[STATE_PHASE]);
   uint j = uint(state[STATE_SOLVE_ITERATIONS]);
@@ -136,24 +140,37 @@ void main() {
         rz[c] = 0.0;
         bz[c] = 0.0;
       }
-      for (uint i = lane; i < n; i += GROUP) {
+      for (uint block = lane; block < blocks; block += GROUP) {
         for (uint c = 0; c < pc.k; ++c) {
-          double ctw = 0.0;
-          for (int e = ctRows[i]; e < ctRows[i + 1]; ++e) {
-            const uint row = uint(ctColumns[e]);
-            precise double w = rho[row] * z[c * m + row] - y[c * m + row];
-            ctw += ctValues[e] * w;
+          double rhsBlock[MAX_BLOCK], residual[MAX_BLOCK];
+          for (uint t = 0; t < pc.b; ++t) {
+            const uint i = block * pc.b + t;
+            double ctw = 0.0;
+            for (int e = ctRows[i]; e < ctRows[i + 1]; ++e) {
+              const uint row = uint(ctColumns[e]);
+              precise double w = rho[row] * z[c * m + row] - y[c * m + row];
+              ctw += ctValues[e] * w;
+            }
+            precise double rhs = (pc.sigma * x[c * n + i] - q[c * n + i]) + ctw;
+            double product = 0.0;
+            for (int e = kRows[i]; e < kRows[i + 1]; ++e) product += kValues[e] * xTilde[c * n + uint(kColumns[e])];
+            rhsBlock[t] = rhs;
+            residual[t] = rhs - product;
+            r[c * n + i] = residual[t];
           }
-          precise double rhs = (pc.sigma * x[c * n + i] - q[c * n + i]) + ctw;
-          double product = 0.0;
-          for (int e = kRows[i]; e < kRows[i + 1]; ++e) product += kValues[e] * xTilde[c * n + uint(kColumns[e])];
-          const double ri = rhs - product;
-          const double zi = inverseDiagonal[i] * ri;
-          r[c * n + i] = ri;
-          zp[c * n + i] = zi;
-          p[c * n + i] = zi;
-          rz[c] += ri * zi;
-          bz[c] += rhs * (inverseDiagonal[i] * rhs);
+          for (uint t = 0; t < pc.b; ++t) {
+            const uint i = block * pc.b + t;
+            double zi = 0.0, mb = 0.0;
+            for (uint u = 0; u < pc.b; ++u) {
+              const double entry = inverseBlocks[(block * pc.b + t) * pc.b + u];
+              zi += entry * residual[u];
+              mb += entry * rhsBlock[u];
+            }
+            zp[c * n + i] = zi;
+            p[c * n + i] = zi;
+            rz[c] += residual[t] * zi;
+            bz[c] += rhsBlock[t] * mb;
+          }
         }
       }
       reduce(rz);
@@ -174,12 +191,14 @@ void main() {
       // Kp = K p and p.Kp
       double pq[MAX_COLUMNS];
       for (uint c = 0; c < MAX_COLUMNS; ++c) pq[c] = 0.0;
-      for (uint i = lane; i < n; i += GROUP) {
-        for (uint c = 0; c < pc.k; ++c) {
-          double product = 0.0;
-          for (int e = kRows[i]; e < kRows[i + 1]; ++e) product += kValues[e] * p[c * n + uint(kColumns[e])];
-          kp[c * n + i] = product;
-          pq[c] += p[c * n + i] * product;
+      for (uint i = lane * pc.b; i < n; i += GROUP * pc.b) {
+        for (uint t = i; t < i + pc.b; ++t) {
+          for (uint c = 0; c < pc.k; ++c) {
+            double product = 0.0;
+            for (int e = kRows[t]; e < kRows[t + 1]; ++e) product += kValues[e] * p[c * n + uint(kColumns[e])];
+            kp[c * n + t] = product;
+            pq[c] += p[c * n + t] * product;
+          }
         }
       }
       reduce(pq);
@@ -187,24 +206,33 @@ void main() {
       // (r = 0) gives p.Kp = 0: it stands still instead of dividing by zero.
       double rzNext[MAX_COLUMNS];
       for (uint c = 0; c < MAX_COLUMNS; ++c) rzNext[c] = 0.0;
-      for (uint i = lane; i < n; i += GROUP) {
+      for (uint block = lane; block < blocks; block += GROUP) {
         for (uint c = 0; c < pc.k; ++c) {
           const double a = pq[c] != 0.0 ? rz[c] / pq[c] : 0.0;
-          xTilde[c * n + i] += a * p[c * n + i];
-          const double ri = r[c * n + i] - a * kp[c * n + i];
-          const double zi = inverseDiagonal[i] * ri;
-          r[c * n + i] = ri;
-          zp[c * n + i] = zi;
-          rzNext[c] += ri * zi;
+          double residual[MAX_BLOCK];
+          for (uint t = 0; t < pc.b; ++t) {
+            const uint i = block * pc.b + t;
+            xTilde[c * n + i] += a * p[c * n + i];
+            residual[t] = r[c * n + i] - a * kp[c * n + i];
+            r[c * n + i] = residual[t];
+          }
+          for (uint t = 0; t < pc.b; ++t) {
+            double zi = 0.0;
+            for (uint u = 0; u < pc.b; ++u) zi += inverseBlocks[(block * pc.b + t) * pc.b + u] * residual[u];
+            zp[c * n + block * pc.b + t] = zi;
+            rzNext[c] += residual[t] * zi;
+          }
         }
       }
       reduce(rzNext);
       // Every invocation has read p across rows (K p) before the reduces' barriers, so p
       // can be overwritten now.
-      for (uint i = lane; i < n; i += GROUP) {
-        for (uint c = 0; c < pc.k; ++c) {
-          const double beta = rz[c] != 0.0 ? rzNext[c] / rz[c] : 0.0;
-          p[c * n + i] = zp[c * n + i] + beta * p[c * n + i];
+      for (uint i = lane * pc.b; i < n; i += GROUP * pc.b) {
+        for (uint t = i; t < i + pc.b; ++t) {
+          for (uint c = 0; c < pc.k; ++c) {
+            const double beta = rz[c] != 0.0 ? rzNext[c] / rz[c] : 0.0;
+            p[c * n + t] = zp[c * n + t] + beta * p[c * n + t];
+          }
         }
       }
       for (uint c = 0; c < pc.k; ++c) rz[c] = rzNext[c];
@@ -233,10 +261,12 @@ void main() {
         z[index] = zNext;
       }
     }
-    for (uint i = lane; i < n; i += GROUP) {
-      for (uint c = 0; c < pc.k; ++c) {
-        precise double xi = pc.alpha * xTilde[c * n + i] + (1.0 - pc.alpha) * x[c * n + i];
-        x[c * n + i] = xi;
+    for (uint i = lane * pc.b; i < n; i += GROUP * pc.b) {
+      for (uint t = i; t < i + pc.b; ++t) {
+        for (uint c = 0; c < pc.k; ++c) {
+          precise double xi = pc.alpha * xTilde[c * n + t] + (1.0 - pc.alpha) * x[c * n + t];
+          x[c * n + t] = xi;
+        }
       }
     }
     synchronize();  // z and y

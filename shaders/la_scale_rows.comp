@@ -1,19 +1,30 @@
 #version 450
-// Y = diag(d) X for m columns of n entries (d has n entries): the Jacobi preconditioner.
+// Y = blockdiag(M) X for m columns of n entries: M holds n / b dense b x b blocks
+// (row-major, block j acting on rows j b .. j b + b - 1). b = 1 is a row scaling, the
+// Jacobi preconditioner; larger b the block-Jacobi one.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
 layout(local_size_x = PLANO_GROUP_SIZE) in;
 
-layout(std430, binding = 0) readonly buffer D { double d[]; };
+layout(std430, binding = 0) readonly buffer Blocks { double blocks[]; };
 layout(std430, binding = 1) readonly buffer X { double x[]; };
 layout(std430, binding = 2) writeonly buffer Y { double y[]; };
 
 layout(push_constant) uniform Push {
   uint n;
   uint m;
+  uint b;
 } pc;
 
 void main() {
-  GRID_STRIDE_LOOP(i, pc.n * pc.m) { y[i] = d[i % pc.n] * x[i]; }
+  GRID_STRIDE_LOOP(i, pc.n * pc.m) {
+    const uint row = i % pc.n;
+    const uint first = row - row % pc.b;  // first row of the block, in this column
+    const uint base = i - (row - first);
+    const uint entries = (row / pc.b) * pc.b * pc.b + (row - first) * pc.b;
+    double sum = 0.0;
+    for (uint t = 0; t < pc.b; ++t) sum += blocks[entries + t] * x[base + t];
+    y[i] = sum;
+  }
 }

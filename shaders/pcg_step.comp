@@ -1,8 +1,9 @@
 #version 450
 // One PCG update for m right-hand sides (n x m column-major), with the step length
 // alpha = (r.z) / (p.q) of each column read from the device's scalars, so that no scalar
-// travels to the host: X += alpha P, R -= alpha Q, Z = Dinv R (Jacobi preconditioner),
-// and in the same pass the first-pass partial sums of the new r.z (finished by la_reduce).
+// travels to the host: X += alpha P, R -= alpha Q, Z = M^-1 R with the block-Jacobi
+// preconditioner (n / b dense b x b inverse blocks, row-major; b = 1: Jacobi), and in the
+// same pass the first-pass partial sums of the new r.z (finished by la_reduce).
 // Dispatch: the dot products' fixed workgroup count in x, one row of groups per column.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -14,7 +15,7 @@ layout(std430, binding = 1) readonly buffer Q { double q[]; };
 layout(std430, binding = 2) buffer X { double x[]; };
 layout(std430, binding = 3) buffer R { double r[]; };
 layout(std430, binding = 4) writeonly buffer Z { double z[]; };
-layout(std430, binding = 5) readonly buffer InverseDiagonal { double inverseDiagonal[]; };
+layout(std430, binding = 5) readonly buffer InverseBlocks { double inverseBlocks[]; };
 layout(std430, binding = 6) readonly buffer Scalars { double scalars[]; };
 layout(std430, binding = 7) writeonly buffer Partial { double partial[]; };
 
@@ -23,7 +24,10 @@ layout(push_constant) uniform Push {
   uint m;
   uint slotRz;  // r.z of the current iterate
   uint slotPq;  // p.q
+  uint b;       // preconditioner block size; divides n, at most MAX_BLOCK
 } pc;
+
+#define MAX_BLOCK 4
 
 shared double sums[PLANO_GROUP_SIZE];
 
@@ -34,13 +38,21 @@ void main() {
   // A converged column (r = 0) gives p.q = 0: stand still instead of dividing by zero.
   const double alpha = pq != 0.0 ? scalars[pc.slotRz * pc.m + column] / pq : 0.0;
   double rz = 0.0;
-  GRID_STRIDE_LOOP(i, pc.n) {
-    x[base + i] += alpha * p[base + i];
-    const double ri = r[base + i] - alpha * q[base + i];
-    const double zi = inverseDiagonal[i] * ri;
-    r[base + i] = ri;
-    z[base + i] = zi;
-    rz += ri * zi;
+  GRID_STRIDE_LOOP(block, pc.n / pc.b) {
+    const uint first = base + block * pc.b;
+    double residual[MAX_BLOCK];
+    for (uint t = 0; t < pc.b; ++t) {
+      x[first + t] += alpha * p[first + t];
+      residual[t] = r[first + t] - alpha * q[first + t];
+      r[first + t] = residual[t];
+    }
+    const uint entries = block * pc.b * pc.b;
+    for (uint t = 0; t < pc.b; ++t) {
+      double zi = 0.0;
+      for (uint u = 0; u < pc.b; ++u) zi += inverseBlocks[entries + t * pc.b + u] * residual[u];
+      z[first + t] = zi;
+      rz += residual[t] * zi;
+    }
   }
   const uint lane = gl_LocalInvocationID.x;
   sums[lane] = rz;

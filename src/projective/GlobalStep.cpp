@@ -151,6 +151,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
 
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.rho = rho_;
+  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
   BoxQpSolver qp(backend_, P_, C, qpSettings);
   Eigen::MatrixXd x = T;
   bool solved = false;

@@ -360,6 +360,41 @@ TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
   }
 }
 
+TEST_F(VulkanAdmm, FaceBlocksPreconditionGlobalStepQpsBetterThanJacobi) {
+  GlobalStepCase problem(8);
+  RecordingBackend recorder;
+  projective::GlobalStep global(recorder, problem.space, problem.fixed, problem.settings);
+  projective::FaceMaps maps;
+  global.solve(problem.targets, problem.at, maps);
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings = recorder.settingsUsed;
+  ASSERT_EQ(settings.preconditionerBlock, 4) << "the global step preconditions by faces";
+  settings.linearSolver.relativeTolerance = 1e-12;
+  const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
+  long iterations[2];
+  for (int jacobi = 0; jacobi < 2; ++jacobi) {
+    compute::AdmmSettings variant = settings;
+    if (jacobi) variant.preconditionerBlock = 1;
+    const AdmmRun device = runAdmm(context(), recorder.qp, variant, kRecordings[1]);
+    expectAgreement(device, host, variant, 1e-5, false);
+    iterations[jacobi] = device.info.linearIterations;
+  }
+  EXPECT_LT(2 * iterations[0], iterations[1]) << "face blocks " << iterations[0] << ", Jacobi " << iterations[1];
+}
+
+TEST_F(VulkanAdmm, PreconditionerBlocksThatDoNotDivideTheUnknownsAreAUsageError) {
+  const BoxQp qp = randomBoxQp(30, 12, 5);
+  compute::AdmmSettings settings;
+  settings.preconditionerBlock = 4;
+  try {
+    vk::AdmmKernels kernels(context(), qp.P, qp.C, settings);
+    ADD_FAILURE() << "blocks of 4 rows accepted for 30 unknowns";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+    EXPECT_NE(std::string(e.what()).find("blocks of 4 rows for 30 unknowns"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
   GlobalStepCase problem(10);
   problem.settings.qp.linearSolver.relativeTolerance = 1e-12;  // the CPU solves exactly

@@ -75,6 +75,33 @@ TEST_F(VulkanLinearAlgebra, DotProductsMatchEigenPerColumnForManySizes) {
   }
 }
 
+TEST_F(VulkanLinearAlgebra, BlockDiagonalProductMatchesEigenForEveryBlockSize) {
+  const Eigen::MatrixXd X = randomBlock(1200, 3, 8);
+  for (std::uint32_t b = 1; b <= 4; ++b) {
+    SCOPED_TRACE(b);
+    const Eigen::MatrixXd entries = randomBlock(1200, b, 9 + b);  // row r: block r / b's row r % b
+    Eigen::MatrixXd expected(1200, 3);
+    for (Index first = 0; first < 1200; first += b) {
+      expected.middleRows(first, b) = entries.middleRows(first, b) * X.middleRows(first, b);
+    }
+    std::vector<double> blocks(1200 * b);
+    for (Index r = 0; r < 1200; ++r) {
+      for (std::uint32_t c = 0; c < b; ++c) blocks[r * b + c] = entries(r, c);
+    }
+    vk::Array<double> deviceBlocks(context(), blocks.size(), vk::MemoryClass::Device, "blocks");
+    deviceBlocks.upload(blocks);
+    vk::DeviceVectors x = vectors(X), y(context(), 1200, 3, "y");
+    vk::Sequence s(context());
+    s.begin();
+    algebra().applyBlockDiagonal(s, deviceBlocks, b, x, y);
+    s.end();
+    s.run();
+    Eigen::MatrixXd Y;
+    y.download(Y);
+    EXPECT_LT(relativeError(Y, expected), 1e-12);
+  }
+}
+
 TEST_F(VulkanLinearAlgebra, AxpbyScaleRowsAndCopyMatchEigen) {
   const Eigen::MatrixXd X = randomBlock(5000, 2, 5), Y = randomBlock(5000, 2, 6);
   const Eigen::VectorXd d = randomBlock(5000, 1, 7).col(0);

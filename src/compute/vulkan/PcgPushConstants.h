@@ -7,6 +7,7 @@ namespace plano::vk {
 
 struct PcgStepPush {
   std::uint32_t n, m, slotRz, slotPq;
+  std::uint32_t block;  ///< Preconditioner block size (1: Jacobi).
 };
 struct PcgSpmvDotPush {
   std::uint32_t n;

@@ -1,5 +1,6 @@
 #include "compute/vulkan/VulkanAdmm.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <string>
 
@@ -30,11 +31,11 @@ struct SupportPush {
   std::uint32_t n;
 };
 struct SingleWorkgroupPush {
-  std::uint32_t n, m, k, iterations, cap, budget, begin, pad;
+  std::uint32_t n, m, k, iterations, cap, budget, begin, block;
   double sigma, alpha, tolerance2;
 };
 struct AssemblePush {
-  std::uint32_t nonZeros, n;
+  std::uint32_t nonZeros, pad;
   double rho;
 };
 
@@ -67,6 +68,43 @@ constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArgu
 std::uint32_t count32(Eigen::Index value, const char* what) {
   if (value < 0 || value > 0x7fffffff) throwDevice(std::string("Vulkan ADMM: ") + what + " too large");
   return static_cast<std::uint32_t>(value);
+}
+
+std::uint32_t blockSize(int block, std::uint32_t n) {
+  if (block < 1 || block > 4 || n % static_cast<std::uint32_t>(block) != 0) {
+    throwUsage("ADMM: preconditioner blocks of " + std::to_string(block) + " rows for " + std::to_string(n) +
+               " unknowns (need 1 to 4 rows dividing the unknowns)");
+  }
+  return static_cast<std::uint32_t>(block);
+}
+
+/// The block-Jacobi preconditioner of K = K0 + rho K1: the inverses of K's b x b diagonal
+/// blocks, row-major. O(n b^2) on the host per rho update; a block that is not positive
+/// definite gets the error of the SPD solvers (K itself cannot be).
+std::vector<double> inverseDiagonalBlocks(const compute::SparseMatrix& K0, const compute::SparseMatrix& K1, double rho,
+                                          std::uint32_t b) {
+  const auto n = static_cast<std::uint32_t>(K0.rows());
+  std::vector<double> inverses(static_cast<std::size_t>(n) * b);
+  Eigen::Matrix4d block;
+  for (std::uint32_t first = 0; first < n; first += b) {
+    block.setZero();
+    for (std::uint32_t r = first; r < first + b; ++r) {
+      for (int e = K0.outerIndexPtr()[r]; e < K0.outerIndexPtr()[r + 1]; ++e) {
+        const auto c = static_cast<std::uint32_t>(K0.innerIndexPtr()[e]);
+        if (c >= first && c < first + b) block(r - first, c - first) = K0.valuePtr()[e] + rho * K1.valuePtr()[e];
+      }
+    }
+    const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(b, b));
+    if (llt.info() != Eigen::Success || !block.topLeftCorner(b, b).allFinite()) {
+      throwNumerical("ADMM: the diagonal block of rows " + std::to_string(first) + " to " +
+                     std::to_string(first + b - 1) + " of K is not positive definite (nor then is K)");
+    }
+    const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(b, b));
+    for (std::uint32_t i = 0; i < b; ++i) {
+      for (std::uint32_t j = 0; j < b; ++j) inverses[(first + i) * b + j] = inverse(i, j);
+    }
+  }
+  return inverses;
 }
 
 /// P + sigma I with explicit zeros wherever C^T C has an entry: the union pattern, so that
@@ -152,8 +190,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       devK_(context, K0_),
       k0Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K0 values"),
       k1Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K1 values"),
-      diagonal_(context, n_, MemoryClass::Device, "ADMM K diagonal positions"),
-      inverseDiagonal_(context, n_, MemoryClass::Device, "ADMM inverse diagonal of K"),
+      block_(blockSize(settings.preconditionerBlock, n_)),
+      inverseBlocks_(context, static_cast<std::size_t>(n_) * block_, MemoryClass::Device,
+                     "ADMM preconditioner blocks"),
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
       recording_(recording),
       unitsPerDispatch_(unitsPerDispatch),
@@ -165,22 +204,14 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       rhs_(context, "admm_rhs", 4, sizeof(RhsPush)),
       update_(context, "admm_update", 7, sizeof(UpdatePush)),
       support_(context, "admm_support", 4, sizeof(SupportPush)),
-      assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
+      assemble_(context, "admm_assemble", 3, sizeof(AssemblePush)),
       singleWorkgroup_(context, "admm_single_workgroup", kSingleWorkgroupBuffers, sizeof(SingleWorkgroupPush),
                        singleWorkgroupSize(context)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
   Ct_.makeCompressed();
-  diagonalIndex_.resize(n_);
-  for (std::uint32_t r = 0; r < n_; ++r) {
-    const int* begin = K0_.innerIndexPtr() + K0_.outerIndexPtr()[r];
-    const int* end = K0_.innerIndexPtr() + K0_.outerIndexPtr()[r + 1];
-    const int* found = std::lower_bound(begin, end, static_cast<int>(r));
-    diagonalIndex_[r] = static_cast<std::int32_t>(found - K0_.innerIndexPtr());
-  }
   k0Values_.upload({K0_.valuePtr(), static_cast<std::size_t>(K0_.nonZeros())});
-  diagonal_.upload(diagonalIndex_);
 }
 
 AdmmKernels::~AdmmKernels() = default;
@@ -201,22 +232,14 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
     k1Values_.upload({K1_.valuePtr(), static_cast<std::size_t>(K1_.nonZeros())});
     equality_ = equality;
   }
-  // The diagonal decides the Jacobi preconditioner; checking it here costs O(n) on the
-  // host and gives the same error as the SPD solvers.
-  for (std::uint32_t r = 0; r < n_; ++r) {
-    const double d = K0_.valuePtr()[diagonalIndex_[r]] + rho * K1_.valuePtr()[diagonalIndex_[r]];
-    if (!(d > 0.0)) {
-      throwNumerical("ADMM: diagonal entry of row " + std::to_string(r) + " of K is " + std::to_string(d) +
-                     " (a symmetric positive definite matrix has a positive diagonal)");
-    }
-  }
+  inverseBlocks_.upload(inverseDiagonalBlocks(K0_, K1_, rho, block_));
   std::vector<double> rows(m_);
   for (std::uint32_t i = 0; i < m_; ++i) rows[i] = equality[i] ? rho * settings_.equalityRhoScale : rho;
   rhoRows_.upload(rows);
   const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
   assembly_.begin();
-  assembly_.dispatch(assemble_, {k0Values_, k1Values_, diagonal_, devK_.values(), inverseDiagonal_},
-                     AssemblePush{nonZeros, n_, rho}, groupsFor(context_, std::max(nonZeros, n_)));
+  assembly_.dispatch(assemble_, {k0Values_, k1Values_, devK_.values()}, AssemblePush{nonZeros, 0, rho},
+                     groupsFor(context_, nonZeros));
   assembly_.end();
   assembly_.run();
   longFirstSolve_ = true;
@@ -242,9 +265,10 @@ std::uint32_t AdmmKernels::singleWorkgroupBudget(std::uint32_t k) const {
   const std::uint64_t group = singleWorkgroupSize(context_), parts = group / kSingleWorkgroupColumns;
   const std::uint64_t columns = k + 1, maxK = longestRow(K0_) + 1;
   const std::uint64_t reduction = columns * (parts + 2) + group / parts + 2;
-  const std::uint64_t rows = (n_ + group - 1) / group, constraintRows = (m_ + group - 1) / group;
-  const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 1) + 2 * reduction;
-  const std::uint64_t pcg = rows * columns * (maxK + 3) + 2 * reduction + 4 * kSingleWorkgroupColumns;
+  const std::uint64_t rows = (n_ / block_ + group - 1) / group * block_;
+  const std::uint64_t constraintRows = (m_ + group - 1) / group;
+  const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 2 * block_ + 2) + 2 * reduction;
+  const std::uint64_t pcg = rows * columns * (maxK + block_ + 4) + 2 * reduction + 4 * kSingleWorkgroupColumns;
   const std::uint64_t update = constraintRows * columns * (longestRow(C_) + 2) + rows * columns;
   const std::uint64_t unit = std::max({start, pcg, update}) + 4;
   const std::uint64_t fixed = 8 * kSingleWorkgroupColumns;
@@ -291,7 +315,7 @@ void AdmmKernels::prepare(std::uint32_t k) {
   w.stepSet = std::make_unique<DescriptorSet>(
       context_, step_,
       std::initializer_list<BufferRange>{w.p.data(), w.Kp.data(), w.xTilde.data(), w.r.data(),
-                                         w.preconditioned.data(), inverseDiagonal_, w.pcg.values(),
+                                         w.preconditioned.data(), inverseBlocks_, w.pcg.values(),
                                          w.pcg.partial()});
   w.directionSet = std::make_unique<DescriptorSet>(
       context_, direction_, std::initializer_list<BufferRange>{w.preconditioned.data(), w.p.data(), w.pcg.values()});
@@ -301,7 +325,7 @@ void AdmmKernels::prepare(std::uint32_t k) {
     w.singleWorkgroupSet = std::make_unique<DescriptorSet>(
         context_, singleWorkgroup_,
         std::initializer_list<BufferRange>{
-            devK_.rowOffsets(), devK_.columns(), devK_.values(), inverseDiagonal_, devC_.rowOffsets(),
+            devK_.rowOffsets(), devK_.columns(), devK_.values(), inverseBlocks_, devC_.rowOffsets(),
             devC_.columns(), devC_.values(), devCt_.rowOffsets(), devCt_.columns(), devCt_.values(), w.q.data(),
             w.x.data(), w.xTilde.data(), w.r.data(), w.preconditioned.data(), w.p.data(), w.Kp.data(),
             w.lower.data(), w.upper.data(), w.y.data(), w.yPrevious.data(), w.z.data(), rhoRows_, w.state});
@@ -360,10 +384,10 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
   la.spmv(s, devK_, w.xTilde, w.Kp);
   la.copy(s, w.rhs, w.r);
   la.axpby(s, -1.0, w.Kp, 1.0, w.r);
-  la.scaleRows(s, inverseDiagonal_, w.r, w.preconditioned);
+  la.applyBlockDiagonal(s, inverseBlocks_, block_, w.r, w.preconditioned);
   la.copy(s, w.preconditioned, w.p);
   la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
-  la.scaleRows(s, inverseDiagonal_, w.rhs, w.Kp);  // Kp as scratch for M^-1 b
+  la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);  // Kp as scratch for M^-1 b
   la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
 
   const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
@@ -382,7 +406,7 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
     s.barrier();
-    s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq}, w.arguments, kFusedArguments);
+    s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq, block_}, w.arguments, kFusedArguments);
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kReduceArguments);
     s.barrier();
@@ -409,7 +433,7 @@ void AdmmKernels::recordSingleWorkgroup(Sequence& s, int count, int dispatches, 
   const DescriptorSet& set = *w.singleWorkgroupSet;
   for (int d = 0; d < dispatches; ++d) {
     const SingleWorkgroupPush push{n_,    m_,    w.k, static_cast<std::uint32_t>(count), cap, w.budget,
-                                   begin && d == 0 ? 1u : 0u, 0, settings_.sigma, settings_.relaxation,
+                                   begin && d == 0 ? 1u : 0u, block_, settings_.sigma, settings_.relaxation,
                                    tolerance * tolerance};
     s.dispatch(singleWorkgroup_, set, push, 1);
     s.barrier();

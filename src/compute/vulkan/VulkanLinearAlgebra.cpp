@@ -22,7 +22,7 @@ struct AxpbyPush {
   double a, b;
 };
 struct ScalePush {
-  std::uint32_t n, m;
+  std::uint32_t n, m, b;
 };
 struct MaxAbsPush {
   std::uint32_t n, terms;
@@ -178,9 +178,17 @@ void LinearAlgebra::axpby(Sequence& sequence, double a, const DeviceVectors& X, 
 }
 
 void LinearAlgebra::scaleRows(Sequence& sequence, const Array<double>& d, const DeviceVectors& X, DeviceVectors& Y) {
-  requireSameShape(X, Y, "scaleRows");
-  if (d.count() != X.n()) throwUsage("scaleRows: diagonal of " + std::to_string(d.count()) + " entries");
-  sequence.dispatch(scaleRows_, {d, X.data(), Y.data()}, ScalePush{X.n(), X.m()},
+  applyBlockDiagonal(sequence, d, 1, X, Y);
+}
+
+void LinearAlgebra::applyBlockDiagonal(Sequence& sequence, const Array<double>& blocks, std::uint32_t b,
+                                       const DeviceVectors& X, DeviceVectors& Y) {
+  requireSameShape(X, Y, "applyBlockDiagonal");
+  if (b == 0 || X.n() % b != 0 || blocks.count() != static_cast<std::size_t>(X.n()) * b) {
+    throwUsage("applyBlockDiagonal: " + std::to_string(blocks.count()) + " block entries for " +
+               std::to_string(X.n()) + " rows in blocks of " + std::to_string(b));
+  }
+  sequence.dispatch(scaleRows_, {blocks, X.data(), Y.data()}, ScalePush{X.n(), X.m(), b},
                     groupsFor(context_, static_cast<std::size_t>(X.n()) * X.m()));
   sequence.barrier();
 }

@@ -103,6 +103,10 @@ class LinearAlgebra {
   void axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y);
   /// Y = diag(d) X, d of n entries applied to every column.
   void scaleRows(Sequence& sequence, const Array<double>& d, const DeviceVectors& X, DeviceVectors& Y);
+  /// Y = blockdiag(M) X: `blocks` holds n / b dense b x b blocks, row-major, block i
+  /// acting on rows b i .. b i + b - 1 of every column (b = 1: scaleRows).
+  void applyBlockDiagonal(Sequence& sequence, const Array<double>& blocks, std::uint32_t b, const DeviceVectors& X,
+                          DeviceVectors& Y);
   /// Y = min(max(X, L), U) entry by entry.
   void clamp(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& L, const DeviceVectors& U,
              DeviceVectors& Y);

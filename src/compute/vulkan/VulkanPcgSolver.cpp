@@ -111,7 +111,7 @@ void PcgSolver::prepare(std::uint32_t m) {
     w.block.dispatch(step_,
                      {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseDiagonal_,
                       w.scalars.values(), w.scalars.partial()},
-                     PcgStepPush{n_, m, current, kPq}, w.scalars.groups(), m);
+                     PcgStepPush{n_, m, current, kPq, 1}, w.scalars.groups(), m);
     w.block.barrier();
     la.reduce(w.block, w.scalars, next);
     w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},
