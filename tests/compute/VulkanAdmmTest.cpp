@@ -338,15 +338,19 @@ struct GlobalStepCase {
   projective::GlobalStepSettings settings;
 };
 
-TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
-  GlobalStepCase problem(8);
-  RecordingBackend recorder;
+/// The first QP of a CPU global step on GlobalStepCase(side), with its settings.
+void captureGlobalStepQp(Index side, RecordingBackend& recorder) {
+  GlobalStepCase problem(side);
   projective::GlobalStep global(recorder, problem.space, problem.fixed, problem.settings);
   projective::FaceMaps maps;
   global.solve(problem.targets, problem.at, maps);
   ASSERT_GT(recorder.qp.q.size(), 0);
   ASSERT_GT(recorder.qp.C.rows(), 0);
+}
 
+TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
   settings.linearSolver.relativeTolerance = 1e-12;
@@ -361,11 +365,8 @@ TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
 }
 
 TEST_F(VulkanAdmm, FaceBlocksPreconditionGlobalStepQpsBetterThanJacobi) {
-  GlobalStepCase problem(8);
   RecordingBackend recorder;
-  projective::GlobalStep global(recorder, problem.space, problem.fixed, problem.settings);
-  projective::FaceMaps maps;
-  global.solve(problem.targets, problem.at, maps);
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
   ASSERT_EQ(settings.preconditionerBlock, 4) << "the global step preconditions by faces";
