@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::compute {
@@ -191,6 +192,8 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     info.status = AdmmStatus::Solved;
   } else {
     while (info.iterations < settings_.maxIterations) {
+      // Between check blocks the iterate is consistent: an interruption loses nothing.
+      throwIfCancelled("the ADMM iteration");
       // Checks at multiples of checkInterval and at maxIterations, as in OSQP.
       const int next = std::min(settings_.maxIterations,
                                 (info.iterations / settings_.checkInterval + 1) * settings_.checkInterval);

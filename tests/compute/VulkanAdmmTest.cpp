@@ -17,6 +17,7 @@
 #include "compute/MeshMatrices.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "mesh/Generators.h"
 #include "projective/GlobalStep.h"
@@ -232,6 +233,19 @@ TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
     const AdmmRun device = runAdmm(context(), qp, settings, recording);
     EXPECT_EQ(device.info.status, compute::AdmmStatus::NonFinite);
     EXPECT_EQ(device.info.iterations, settings.checkInterval);
+  }
+}
+
+TEST_F(VulkanAdmm, CancellationStopsTheIterationOnBothBackends) {
+  const BoxQp qp = randomBoxQp(40, 30, 3);
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings;
+  for (compute::Backend* backend : {static_cast<compute::Backend*>(&cpu), static_cast<compute::Backend*>(&backend())}) {
+    SCOPED_TRACE(backend->name());
+    requestCancellation();
+    EXPECT_THROW(runAdmm(*backend, qp, settings), Interrupted);
+    clearCancellation();
+    EXPECT_EQ(runAdmm(*backend, qp, settings).info.status, compute::AdmmStatus::Solved);
   }
 }
 
