@@ -169,7 +169,8 @@ struct AdmmKernels::Workspace {
   std::unique_ptr<DescriptorSet> spmvDotSet, reduceSet, stepSet, directionSet, controlSet, singleWorkgroupSet;
   Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
   Sequence check;  ///< The inf-norms of AdmmMeasures.
-  /// Recorded blocks by 2 * iteration count + (first solve long).
+  /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
+  /// single-workgroup by 8192 * iteration count + dispatch count.
   std::map<int, std::unique_ptr<Sequence>> blocks;
 };
 
