@@ -158,6 +158,7 @@ struct AdmmKernels::Workspace {
   bool singleWorkgroup = false;
   std::uint32_t budget = 0;                  ///< Units of work per single-workgroup dispatch.
   double expectedInnerIterations = 16.0;     ///< Per solve, from the last block (sizes recordings).
+  double innerIterationsSeen = 0.0;          ///< The state's PCG iteration total after the last block.
   std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
@@ -456,9 +457,11 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
     recordSingleWorkgroup(*first, count, dispatches, true);
     first->end();
   }
-  const double innerBefore = stateValue(kInnerIterations);
   first->run();
-  while (stateValue(kRemaining) > 0.0) {
+  // One read-back per run: the position tells whether the block is done.
+  double state[kStateSize];
+  w.state.download(state);
+  while (state[kRemaining] > 0.0) {
     throwIfCancelled("the ADMM iteration");
     auto& resume = w.resumes[dispatches];
     if (!resume) {
@@ -468,14 +471,10 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
       resume->end();
     }
     resume->run();
+    w.state.download(state);
   }
-  w.expectedInnerIterations = std::max(1.0, (stateValue(kInnerIterations) - innerBefore) / count);
-}
-
-double AdmmKernels::stateValue(std::uint32_t slot) {
-  double state[kStateSize];
-  workspace_->state.download(state);
-  return state[slot];
+  w.expectedInnerIterations = std::max(1.0, (state[kInnerIterations] - w.innerIterationsSeen) / count);
+  w.innerIterationsSeen = state[kInnerIterations];
 }
 
 Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
@@ -509,6 +508,7 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   w.y.upload(y);
   const double zeros[kStateSize] = {};
   w.state.upload(zeros);
+  w.innerIterationsSeen = 0.0;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
   w.start.run();

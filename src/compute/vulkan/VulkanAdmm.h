@@ -26,14 +26,14 @@
 // start is the poorest, always gets kMaxInnerIterations. A fixed count without the flag would either waste work or stop
 // short on every solve.
 //
-// Small problems take another recording of the same iteration: the whole block between
-// two checks runs in one workgroup (shaders/admm_single_workgroup.comp), which loops over
-// the ADMM and PCG iterations itself. There a dispatch costs more than the arithmetic it
-// carries, and the multi-dispatch recording pays six per PCG iteration, most of them
-// empty. The kernel is resumable: each dispatch does a budget of work and saves its
-// position, a recording holds the dispatches the last block needed, and a block that
-// needs more runs a resume recording (the host reads 8 bytes to know). Its inner solve
-// stops at the tolerance or at kMaxInnerIterations.
+// Small problems take another recording of the same iteration: the whole block between two
+// checks runs in one workgroup (shaders/admm_single_workgroup.comp), which loops over the ADMM
+// and PCG iterations itself. There a dispatch costs more than the arithmetic it carries, and
+// the multi-dispatch recording pays six per PCG iteration, most of them empty. The kernel is
+// resumable: each dispatch does a budget of work and saves its position, a recording holds the
+// dispatches the last block needed, and a block that needs more runs a resume recording (the
+// host reads the kernel's small state after each run to know). Its inner solve stops at the
+// tolerance or at kMaxInnerIterations.
 #include <map>
 #include <memory>
 
@@ -87,7 +87,6 @@ class AdmmKernels final : public compute::AdmmKernels {
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
   void iterateSingleWorkgroup(int count);
-  double stateValue(std::uint32_t slot);
   std::uint32_t singleWorkgroupBudget(std::uint32_t k) const;
   bool useSingleWorkgroup(std::uint32_t k) const;
 
