@@ -55,17 +55,20 @@ layout(std430, binding = 19) coherent buffer Y { double y[]; };
 layout(std430, binding = 20) writeonly buffer YPrevious { double yPrevious[]; };
 layout(std430, binding = 21) coherent buffer Z { double z[]; };
 layout(std430, binding = 22) readonly buffer Rho { double rho[]; };
-// [1] inner iterations run, [2] solves stopped by the cap (as pcg_control's state), then
-// the resumable position: ADMM iterations left in the block, phase (0: next unit starts a
-// solve, 1: inside the PCG), PCG iterations of the current solve, r.z and b.z per column.
+// [1] inner iterations run, [2] solves stopped by the cap, [3] the squared tolerance on
+// ||r|| set by the host (as pcg_control's state), then the resumable position: ADMM
+// iterations left in the block, phase (0: next unit starts a solve, 1: inside the PCG),
+// PCG iterations of the current solve, r.z, b.z and r.r per column.
 layout(std430, binding = 23) buffer State { double state[]; };
 #define STATE_INNER 1
 #define STATE_CAPPED 2
-#define STATE_REMAINING 3
-#define STATE_PHASE 4
-#define STATE_SOLVE_ITERATIONS 5
-#define STATE_RZ 6
+#define STATE_TOLERANCE2 3
+#define STATE_REMAINING 4
+#define STATE_PHASE 5
+#define STATE_SOLVE_ITERATIONS 6
+#define STATE_RZ 7
 #define STATE_BZ (STATE_RZ + MAX_COLUMNS)
+#define STATE_RR (STATE_BZ + MAX_COLUMNS)
 
 layout(push_constant) uniform Push {
   uint n;
@@ -78,33 +81,42 @@ layout(push_constant) uniform Push {
   uint b;           // preconditioner block size: divides n, at most MAX_BLOCK
   double sigma;
   double alpha;       // over-relaxation
-  double tolerance2;  // PCG stops when r.z <= tolerance2 * b.z in every column
+  double tolerance2;  // relative: PCG stops when r.z <= tolerance2 * b.z (and ||r|| is small)
 } pc;
 
-shared double sums[MAX_COLUMNS][GROUP];
-shared double parts[MAX_COLUMNS][PARTS];
+shared double sums[2 * MAX_COLUMNS][GROUP];
+shared double parts[2 * MAX_COLUMNS][PARTS];
 
-// Sum every column's per-invocation values over the workgroup; all invocations get the
-// totals. Two levels (PARTS partial sums, then every invocation adds those) cost two
-// barriers instead of a tree's log2(GROUP). The next reduce may start at once: its writes
-// to sums follow this one's last barrier, and its writes to parts its own first.
-void reduce(inout double value[MAX_COLUMNS]) {
+// Sum every column's per-invocation values of `count` (1 or 2) quantities over the
+// workgroup; all invocations get the totals. Two levels (PARTS partial sums, then every
+// invocation adds those) cost two barriers instead of a tree's log2(GROUP). The next
+// reduce may start at once: its writes to sums follow this one's last barrier, and its
+// writes to parts its own first.
+void reduce(uint count, inout double first[MAX_COLUMNS], inout double second[MAX_COLUMNS]) {
   const uint lane = gl_LocalInvocationID.x;
-  for (uint c = 0; c < pc.k; ++c) sums[c][lane] = value[c];
+  for (uint c = 0; c < pc.k; ++c) {
+    sums[c][lane] = first[c];
+    if (count == 2) sums[MAX_COLUMNS + c][lane] = second[c];
+  }
   barrier();
   const uint chunk = GROUP / PARTS;
-  if (lane < PARTS * pc.k) {
-    const uint c = lane / PARTS;
-    const uint first = (lane % PARTS) * chunk;
+  for (uint slot = lane; slot < PARTS * MAX_COLUMNS * count; slot += GROUP) {
+    const uint row = slot / PARTS;  // quantity * MAX_COLUMNS + column
+    if (row % MAX_COLUMNS >= pc.k) continue;
+    const uint begin = (slot % PARTS) * chunk;
     double sum = 0.0;
-    for (uint t = 0; t < chunk; ++t) sum += sums[c][first + t];
-    parts[c][lane % PARTS] = sum;
+    for (uint t = 0; t < chunk; ++t) sum += sums[row][begin + t];
+    parts[row][slot % PARTS] = sum;
   }
   barrier();
   for (uint c = 0; c < pc.k; ++c) {
-    double sum = 0.0;
+    double sum = 0.0, other = 0.0;
     for (uint t = 0; t < PARTS; ++t) sum += parts[c][t];
-    value[c] = sum;
+    if (count == 2) {
+      for (uint t = 0; t < PARTS; ++t) other += parts[MAX_COLUMNS + c][t];
+      second[c] = other;
+    }
+    first[c] = sum;
   }
 }
 
@@ -122,10 +134,15 @@ void main() {
   uint remaining = pc.begin != 0 ? pc.iterations : uint(state[STATE_REMAINING]);
   uint phase = pc.begin != 0 ? 0 : uint(state[STATE_PHASE]);
   uint j = uint(state[STATE_SOLVE_ITERATIONS]);
-  double rz[MAX_COLUMNS], bz[MAX_COLUMNS];
+  // The inner solve stops when, in every column, r.z <= tolerance2 b.z and ||r||^2 <=
+  // absolute2, an absolute bound that the host derives from the ADMM's own residuals
+  // (compute/Admm.h): with stiff equality rows b is far larger than the residuals.
+  const double absolute2 = state[STATE_TOLERANCE2];
+  double rz[MAX_COLUMNS], bz[MAX_COLUMNS], rr[MAX_COLUMNS];
   for (uint c = 0; c < MAX_COLUMNS; ++c) {
     rz[c] = state[STATE_RZ + c];
     bz[c] = state[STATE_BZ + c];
+    rr[c] = state[STATE_RR + c];
   }
   barrier();  // every invocation has read the state before lane 0 may rewrite it
   uint innerIterations = 0;
@@ -135,10 +152,11 @@ void main() {
     --budget;
     if (phase == 0) {
       // rhs = sigma x - q + C^T (rho z - y); PCG start from xTilde: r = rhs - K xTilde,
-      // zp = M^-1 r, p = zp, and the dot products r.zp and rhs.M^-1 rhs.
+      // zp = M^-1 r, p = zp, and the dot products r.zp, rhs.M^-1 rhs and r.r.
       for (uint c = 0; c < MAX_COLUMNS; ++c) {
         rz[c] = 0.0;
         bz[c] = 0.0;
+        rr[c] = 0.0;
       }
       for (uint block = lane; block < blocks; block += GROUP) {
         for (uint c = 0; c < pc.k; ++c) {
@@ -170,11 +188,13 @@ void main() {
             p[c * n + i] = zi;
             rz[c] += residual[t] * zi;
             bz[c] += rhsBlock[t] * mb;
+            rr[c] += residual[t] * residual[t];
           }
         }
       }
-      reduce(rz);
-      reduce(bz);
+      reduce(2, rz, bz);
+      double unused[MAX_COLUMNS];
+      reduce(1, rr, unused);
       synchronize();  // p
       phase = 1;
       j = 0;
@@ -183,7 +203,8 @@ void main() {
 
     bool running = false;
     for (uint c = 0; c < pc.k; ++c) {
-      if (!(rz[c] <= pc.tolerance2 * bz[c])) running = true;  // NaN keeps running into the iterate
+      // NaN keeps running into the iterate.
+      if (!(rz[c] <= pc.tolerance2 * bz[c]) || !(rr[c] <= absolute2)) running = true;
     }
     if (running && j < pc.cap) {
       ++j;
@@ -201,15 +222,19 @@ void main() {
           }
         }
       }
-      reduce(pq);
+      double unused[MAX_COLUMNS];
+      reduce(1, pq, unused);
       // xTilde += a p, r -= a Kp, zp = M^-1 r, and the new r.zp. A converged column
       // (r = 0) gives p.Kp = 0: it stands still instead of dividing by zero.
       double rzNext[MAX_COLUMNS];
-      for (uint c = 0; c < MAX_COLUMNS; ++c) rzNext[c] = 0.0;
+      for (uint c = 0; c < MAX_COLUMNS; ++c) {
+        rzNext[c] = 0.0;
+        rr[c] = 0.0;
+      }
       for (uint block = lane; block < blocks; block += GROUP) {
         for (uint c = 0; c < pc.k; ++c) {
           const double a = pq[c] != 0.0 ? rz[c] / pq[c] : 0.0;
-          double residual[MAX_BLOCK];
+          double rhsBlock[MAX_BLOCK], residual[MAX_BLOCK];
           for (uint t = 0; t < pc.b; ++t) {
             const uint i = block * pc.b + t;
             xTilde[c * n + i] += a * p[c * n + i];
@@ -221,10 +246,11 @@ void main() {
             for (uint u = 0; u < pc.b; ++u) zi += inverseBlocks[(block * pc.b + t) * pc.b + u] * residual[u];
             zp[c * n + block * pc.b + t] = zi;
             rzNext[c] += residual[t] * zi;
+            rr[c] += residual[t] * residual[t];
           }
         }
       }
-      reduce(rzNext);
+      reduce(2, rzNext, rr);
       // Every invocation has read p across rows (K p) before the reduces' barriers, so p
       // can be overwritten now.
       for (uint i = lane * pc.b; i < n; i += GROUP * pc.b) {
@@ -282,6 +308,7 @@ void main() {
     for (uint c = 0; c < MAX_COLUMNS; ++c) {
       state[STATE_RZ + c] = rz[c];
       state[STATE_BZ + c] = bz[c];
+      state[STATE_RR + c] = rr[c];
     }
   }
 }

@@ -2,10 +2,11 @@
 // Device-side convergence control of a PCG solve recorded as a fixed number of iterations
 // (the inner solve of the device ADMM). Run before each recorded iteration, it writes the
 // indirect dispatch sizes of that iteration: its full sizes while some column still has
-// r.z > tol^2 b.z, zero once all have converged, so the rest of the recorded iterations
-// cost empty dispatches and the solution is that of a PCG stopped at the tolerance. NaN
-// counts as not converged, so that it reaches the iterate. state: [0] done flag of this
-// solve, [1] iterations run, [2] solves stopped by the recorded cap.
+// r.z > tol^2 b.z or r.r > abs^2, zero once all have converged, so the rest of the
+// recorded iterations cost empty dispatches and the solution is that of a PCG stopped at
+// the tolerance. NaN counts as not converged, so that it reaches the iterate. state: [0]
+// done flag of this solve, [1] iterations run, [2] solves stopped by the recorded cap,
+// [3] abs^2, an absolute bound the host derives from the ADMM's residuals (compute/Admm.h).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
@@ -17,7 +18,7 @@ layout(std430, binding = 2) writeonly buffer Arguments { uint arguments[]; };
 
 layout(push_constant) uniform Push {
   uint m;
-  uint slotRz;
+  uint slotRz;  // r.z of the current iterate; its r.r is in the next slot
   uint slotBz;
   uint mode;  // 0: first check of a solve, 1: later check, 2: after the last recorded iteration
   uint groupsColumn;     // workgroups per column of the fused PCG kernels
@@ -33,7 +34,8 @@ void main() {
   if (running) {
     bool any = false;
     for (uint c = 0; c < pc.m; ++c) {
-      if (!(scalars[pc.slotRz * pc.m + c] <= pc.tolerance2 * scalars[pc.slotBz * pc.m + c])) any = true;
+      const double rz = scalars[pc.slotRz * pc.m + c], rr = scalars[(pc.slotRz + 1) * pc.m + c];
+      if (!(rz <= pc.tolerance2 * scalars[pc.slotBz * pc.m + c]) || !(rr <= state[3])) any = true;
     }
     running = any;
   }
@@ -46,7 +48,8 @@ void main() {
   } else {
     state[0] = 1.0;
   }
-  // [0..2]: fused kernels (groupsColumn x m), [3..5]: reductions (m), [6..8]: direction.
+  // [0..2]: fused kernels (groupsColumn x m), [3..5]: reductions (m), [6..8]: direction,
+  // [9..11]: paired reductions (2m: r.z and r.r).
   arguments[0] = running ? pc.groupsColumn : 0;
   arguments[1] = pc.m;
   arguments[2] = 1;
@@ -56,4 +59,7 @@ void main() {
   arguments[6] = running ? pc.groupsDirection : 0;
   arguments[7] = 1;
   arguments[8] = 1;
+  arguments[9] = running ? 2 * pc.m : 0;
+  arguments[10] = 1;
+  arguments[11] = 1;
 }

@@ -3,7 +3,9 @@
 // alpha = (r.z) / (p.q) of each column read from the device's scalars, so that no scalar
 // travels to the host: X += alpha P, R -= alpha Q, Z = M^-1 R with the block-Jacobi
 // preconditioner (n / b dense b x b inverse blocks, row-major; b = 1: Jacobi), and in the
-// same pass the first-pass partial sums of the new r.z (finished by la_reduce).
+// same pass the first-pass partial sums of the new r.z (finished by la_reduce) and, when
+// asked, of r.r after them (partial sums of column c's r.r at column m + c, so that one
+// la_reduce over 2m columns writes r.r into the slot after r.z's).
 // Dispatch: the dot products' fixed workgroup count in x, one row of groups per column.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -25,11 +27,13 @@ layout(push_constant) uniform Push {
   uint slotRz;  // r.z of the current iterate
   uint slotPq;  // p.q
   uint b;       // preconditioner block size; divides n, at most MAX_BLOCK
+  uint residualNorms;  // 1: also the partial sums of r.r
 } pc;
 
 #define MAX_BLOCK 4
 
 shared double sums[PLANO_GROUP_SIZE];
+shared double squares[PLANO_GROUP_SIZE];
 
 void main() {
   const uint column = gl_WorkGroupID.y;
@@ -37,7 +41,7 @@ void main() {
   const double pq = scalars[pc.slotPq * pc.m + column];
   // A converged column (r = 0) gives p.q = 0: stand still instead of dividing by zero.
   const double alpha = pq != 0.0 ? scalars[pc.slotRz * pc.m + column] / pq : 0.0;
-  double rz = 0.0;
+  double rz = 0.0, rr = 0.0;
   GRID_STRIDE_LOOP(block, pc.n / pc.b) {
     const uint first = base + block * pc.b;
     double residual[MAX_BLOCK];
@@ -52,14 +56,22 @@ void main() {
       for (uint u = 0; u < pc.b; ++u) zi += inverseBlocks[entries + t * pc.b + u] * residual[u];
       z[first + t] = zi;
       rz += residual[t] * zi;
+      rr += residual[t] * residual[t];
     }
   }
   const uint lane = gl_LocalInvocationID.x;
   sums[lane] = rz;
+  squares[lane] = rr;
   barrier();
   for (uint width = PLANO_GROUP_SIZE / 2; width > 0; width /= 2) {
-    if (lane < width) sums[lane] += sums[lane + width];
+    if (lane < width) {
+      sums[lane] += sums[lane + width];
+      squares[lane] += squares[lane + width];
+    }
     barrier();
   }
-  if (lane == 0) partial[column * gl_NumWorkGroups.x + gl_WorkGroupID.x] = sums[0];
+  if (lane == 0) {
+    partial[column * gl_NumWorkGroups.x + gl_WorkGroupID.x] = sums[0];
+    if (pc.residualNorms != 0) partial[(pc.m + column) * gl_NumWorkGroups.x + gl_WorkGroupID.x] = squares[0];
+  }
 }

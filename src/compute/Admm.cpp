@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/Cancellation.h"
@@ -129,6 +130,9 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
                        const AdmmSettings& settings)
     : kernels_(std::move(kernels)), n_(n), m_(m), settings_(settings), rho_(settings.rho) {
   if (settings_.checkInterval < 1) throwUsage("ADMM: checkInterval must be at least 1");
+  if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
+    throwUsage("ADMM: linearToleranceFraction must be a finite number > 0");
+  }
 }
 
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -159,6 +163,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
   // Residuals, tolerances and the rho balance at the current iterate. Returns true when converged.
   AdmmMeasures s;
   double rhoBalance = 1.0;
+  double linearTolerance = std::numeric_limits<double>::infinity();
   auto converged = [&]() {
     info.primalResidual = maxOf(s.primalResidual);
     info.dualResidual = maxOf(s.dualResidual);
@@ -169,6 +174,10 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     const double tiny = 1e-30;
     rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /
                            std::max(info.dualResidual / std::max(dualScale, tiny), tiny));
+    // The next blocks' bound on the inner solves' residuals (AdmmSettings::linearToleranceFraction).
+    const double fraction = settings_.linearToleranceFraction;
+    linearTolerance = std::min(linearTolerance, fraction * std::max(std::min(info.primalResidual, info.dualResidual),
+                                                                    std::min(epsPrimal, epsDual)));
     return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
   };
 
@@ -197,6 +206,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
       // Checks at multiples of checkInterval and at maxIterations, as in OSQP.
       const int next = std::min(settings_.maxIterations,
                                 (info.iterations / settings_.checkInterval + 1) * settings_.checkInterval);
+      kernels_->setLinearTolerance(linearTolerance);
       kernels_->iterate(next - info.iterations);
       info.iterations = next;
       s = kernels_->measure();

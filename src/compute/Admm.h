@@ -33,6 +33,15 @@ struct AdmmSettings {
   int checkInterval = 10;                ///< Residuals and certificates every this many iterations.
   bool adaptiveRho = true;
   double adaptiveRhoFactor = 5.0;        ///< Change K only when rho moves by more than this factor.
+  /// Iterative backends stop each inner solve with K when ||r||_2 <= relativeTolerance
+  /// ||b|| (linearSolver, in the preconditioner's norm) AND ||r||_2 <= this fraction of the
+  /// smaller ADMM residual at the last check (never below this fraction of the smaller
+  /// convergence tolerance). With stiff equality rows (rho * equalityRhoScale) the
+  /// right-hand side is orders of magnitude larger than the residuals, and a tolerance
+  /// relative to it alone left solve errors larger than the dual residual: the rho
+  /// balance then drifted from the exact iteration's. The inexact step's error enters the
+  /// residuals about one to one, so a small fraction keeps the iteration the host's.
+  double linearToleranceFraction = 1e-2;
   LinearSolverSettings linearSolver;     ///< Of the solves with K (iterative backends).
   /// Rows per block of the iterative backends' block-Jacobi preconditioner of K (1 to 4;
   /// 1 is Jacobi): rows b i .. b i + b - 1 form block i, so n must be a multiple of b.
@@ -91,6 +100,10 @@ class AdmmKernels {
   /// The last iteration first saves y for the certificate's dy.
   virtual void iterate(int count) = 0;
   virtual AdmmMeasures measure() = 0;
+  /// Absolute bound on each column's ||r||_2 for the inner solves of the following
+  /// iterate() calls (AdmmSettings::linearToleranceFraction). Kernels that solve exactly
+  /// (a factorization) have nothing to tighten and ignore it.
+  virtual void setLinearTolerance(double tolerance) { (void)tolerance; }
   /// The current x, y and z (n x k, m x k, m x k).
   virtual void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) = 0;
 };

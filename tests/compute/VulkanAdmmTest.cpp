@@ -4,7 +4,8 @@
 // tolerance. The host solves exactly (CHOLMOD), so the tests that compare iterates ask the
 // device PCG for 1e-12 (the default 1e-10 leaves ~1e-7 in x on these conditionings).
 // On the random QPs the iterations and rho updates are the host's and x agrees to 1e-8;
-// on the global-step QP (face-block preconditioner) too, with x to 3.5e-8 of its size.
+// on the global-step QP (face-block preconditioner) too, with x to 3.3e-9 of its size
+// (3.5e-8 before the inner solves were also bounded by the ADMM residuals).
 #include "compute/vulkan/VulkanAdmm.h"
 
 #include <gtest/gtest.h>
@@ -118,7 +119,7 @@ BoxQp randomBoxQp(Index n, Index m, unsigned seed) {
 }
 
 void expectAgreement(const AdmmRun& device, const AdmmRun& host, const compute::AdmmSettings& settings, double tolerance,
-                     bool sameRhoHistory = true) {
+                     bool sameRhoHistory = true, bool baseline = false) {
   SCOPED_TRACE("iterations: host " + std::to_string(host.info.iterations) + ", device " +
                std::to_string(device.info.iterations) + "; device PCG iterations " +
                std::to_string(device.info.linearIterations));
@@ -128,8 +129,9 @@ void expectAgreement(const AdmmRun& device, const AdmmRun& host, const compute::
     EXPECT_EQ(device.info.factorizations, host.info.factorizations);
   }
   // Inner solves stopped by the recorded cap are allowed (the cap grows after them), but
-  // they stay a small fraction of the solves.
-  EXPECT_LE(device.info.inexactSolves, device.info.iterations / 3);
+  // they stay a small fraction of the solves (not so for a weaker preconditioner run as
+  // a baseline).
+  if (!baseline) EXPECT_LE(device.info.inexactSolves, device.info.iterations / 3);
   EXPECT_LT(relativeDifference(device.x, host.x), tolerance);
   EXPECT_LT(relativeDifference(device.y, host.y), tolerance * 1e2);
 }
@@ -373,8 +375,32 @@ TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
   for (const Recording& recording : kRecordings) {
     SCOPED_TRACE(recording.name);
     const AdmmRun device = runAdmm(context(), recorder.qp, settings, recording);
-    expectAgreement(device, host, settings, 5e-8);  // measured 3.5e-8
+    expectAgreement(device, host, settings, 1e-8);  // measured 3.3e-9
   }
+}
+
+// With eps = 0 every row is an equality row (rho * 1e3): the right-hand sides of the inner
+// solves are far larger than the ADMM residuals, so a PCG tolerance relative to them alone
+// leaves errors above the dual residual and the rho balance drifts (measured: 40 ADMM
+// iterations and final rho 3.9 against the host's 30 and 2470). The bound from the ADMM
+// residuals keeps the host's iteration with the default inner tolerance.
+TEST_F(VulkanAdmm, EqualityRowsKeepTheHostIterationWithTheDefaultInnerTolerance) {
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
+  compute::CpuBackend cpu;
+  const compute::AdmmSettings settings = recorder.settingsUsed;
+  ASSERT_EQ(settings.linearSolver.relativeTolerance, compute::LinearSolverSettings{}.relativeTolerance);
+  ASSERT_TRUE((recorder.qp.lower.array() == recorder.qp.upper.array()).all()) << "every row an equality";
+  const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
+  ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
+  const AdmmRun device = runAdmm(context(), recorder.qp, settings, kRecordings[1]);
+  EXPECT_EQ(device.info.iterations, host.info.iterations);
+  expectAgreement(device, host, settings, 1e-6);
+
+  compute::AdmmSettings relativeOnly = settings;
+  relativeOnly.linearToleranceFraction = 1e30;
+  const AdmmRun drifting = runAdmm(context(), recorder.qp, relativeOnly, kRecordings[1]);
+  EXPECT_GT(drifting.info.iterations, host.info.iterations) << "the bound made no difference on this QP";
 }
 
 TEST_F(VulkanAdmm, FaceBlocksPreconditionGlobalStepQpsBetterThanJacobi) {
@@ -390,7 +416,7 @@ TEST_F(VulkanAdmm, FaceBlocksPreconditionGlobalStepQpsBetterThanJacobi) {
     compute::AdmmSettings variant = settings;
     if (jacobi) variant.preconditionerBlock = 1;
     const AdmmRun device = runAdmm(context(), recorder.qp, variant, kRecordings[1]);
-    expectAgreement(device, host, variant, 1e-5, false);
+    expectAgreement(device, host, variant, 1e-5, false, jacobi == 1);
     iterations[jacobi] = device.info.linearIterations;
   }
   EXPECT_LT(2 * iterations[0], iterations[1]) << "face blocks " << iterations[0] << ", Jacobi " << iterations[1];

@@ -8,6 +8,7 @@ namespace plano::vk {
 struct PcgStepPush {
   std::uint32_t n, m, slotRz, slotPq;
   std::uint32_t block;  ///< Preconditioner block size (1: Jacobi).
+  std::uint32_t residualNorms = 0;  ///< 1: also r.r's partial sums (needs 2m columns of partials).
 };
 struct PcgSpmvDotPush {
   std::uint32_t n;

@@ -39,18 +39,20 @@ struct AssemblePush {
   double rho;
 };
 
-// PCG scalar slots (k values each).
-enum PcgSlot : std::uint32_t { kRzEven = 0, kRzOdd, kPq, kBz, kPcgSlots };
+// PCG scalar slots (k values each). r.r follows its r.z: pcg_step's paired reduction
+// writes both.
+enum PcgSlot : std::uint32_t { kRzEven = 0, kRrEven, kRzOdd, kRrOdd, kPq, kBz, kPcgSlots };
 // Check scalar slots (k values each), in AdmmMeasures' order.
 enum MeasureSlot : std::uint32_t {
   kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
 };
-// pcg_control's state and its indirect arguments (byte offsets of the three triples).
-// pcg_control's state, then the resumable position of admm_single_workgroup.
+// pcg_control's state (with the squared tolerance on ||r|| set by the host), then the
+// resumable position of admm_single_workgroup.
 enum State : std::uint32_t {
-  kDone = 0, kInnerIterations, kCappedSolves, kRemaining, kPhase, kSolveIterations, kStateRz,
+  kDone = 0, kInnerIterations, kCappedSolves, kLinearTolerance2, kRemaining, kPhase, kSolveIterations, kStateRz,
   kStateBz = kStateRz + AdmmKernels::kSingleWorkgroupColumns,
-  kStateSize = kStateBz + AdmmKernels::kSingleWorkgroupColumns
+  kStateRr = kStateBz + AdmmKernels::kSingleWorkgroupColumns,
+  kStateSize = kStateRr + AdmmKernels::kSingleWorkgroupColumns
 };
 // llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
 // single-workgroup kernel's budget keeps its estimate below half of that.
@@ -63,7 +65,8 @@ bool isCpuDevice(const Context& context) { return context.info().type == VK_PHYS
 /// The single-workgroup kernel's size: on CPU devices every invocation pays for every
 /// barrier, so fewer; on GPUs more lanes sweep the rows.
 std::uint32_t singleWorkgroupSize(const Context& context) { return isCpuDevice(context) ? 64 : 256; }
-constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24;
+// pcg_control's indirect arguments (byte offsets of its four triples).
+constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24, kPairReduceArguments = 36;
 
 std::uint32_t count32(Eigen::Index value, const char* what) {
   if (value < 0 || value > 0x7fffffff) throwDevice(std::string("Vulkan ADMM: ") + what + " too large");
@@ -148,10 +151,10 @@ struct AdmmKernels::Workspace {
         w(context, m, k, "ADMM rho z - y"),
         Cx(context, m, k, "ADMM C x"),
         dy(context, m, k, "ADMM dy"),
-        pcg(context, kPcgSlots, k, n),
+        pcg(context, kPcgSlots, k, n, 2 * k),
         measures(context, kMeasureSlots, k, std::max(n, m)),
         state(context, kStateSize, MemoryClass::Device, "PCG control state"),
-        arguments(context, 9, MemoryClass::Device, "PCG indirect arguments"),
+        arguments(context, 12, MemoryClass::Device, "PCG indirect arguments"),
         start(context),
         check(context) {}
   std::uint32_t k;
@@ -159,6 +162,7 @@ struct AdmmKernels::Workspace {
   std::uint32_t budget = 0;                  ///< Units of work per single-workgroup dispatch.
   double expectedInnerIterations = 16.0;     ///< Per solve, from the last block (sizes recordings).
   double innerIterationsSeen = 0.0;          ///< The state's PCG iteration total after the last block.
+  double uploadedTolerance = -1.0;           ///< The inner tolerance in the state (-1: none yet).
   std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
@@ -266,7 +270,8 @@ std::uint32_t AdmmKernels::singleWorkgroupBudget(std::uint32_t k) const {
   // bounded from above: rows per invocation times the longest rows, plus the reductions.
   const std::uint64_t group = singleWorkgroupSize(context_), parts = group / kSingleWorkgroupColumns;
   const std::uint64_t columns = k + 1, maxK = longestRow(K0_) + 1;
-  const std::uint64_t reduction = columns * (parts + 2) + group / parts + 2;
+  // A reduction of two quantities (the costlier kind): loops over columns and parts, twice.
+  const std::uint64_t reduction = 2 * columns * (parts + 2) + 2 * (group / parts + 2) + columns;
   const std::uint64_t rows = (n_ / block_ + group - 1) / group * block_;
   const std::uint64_t constraintRows = (m_ + group - 1) / group;
   const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 2 * block_ + 2) + 2 * reduction;
@@ -382,21 +387,23 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
              groupsFor(context_, nk));
   s.barrier();
 
-  // PCG start from xTilde: r = rhs - K xTilde, preconditioned = M^-1 r, p = it, r.z, b.z.
+  // PCG start from xTilde: r = rhs - K xTilde, preconditioned = M^-1 r, p = it, r.z, r.r, b.z.
   la.spmv(s, devK_, w.xTilde, w.Kp);
   la.copy(s, w.rhs, w.r);
   la.axpby(s, -1.0, w.Kp, 1.0, w.r);
   la.applyBlockDiagonal(s, inverseBlocks_, block_, w.r, w.preconditioned);
   la.copy(s, w.preconditioned, w.p);
   la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
+  la.dot(s, w.r, w.r, w.pcg, kRrEven);
   la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);  // Kp as scratch for M^-1 b
   la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
 
-  const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
   const std::uint32_t groups = w.pcg.groups();
   const std::uint32_t directionGroups = groupsFor(context_, nk);
-  auto control = [&](std::uint32_t mode, std::uint32_t slot) {
-    s.dispatch(control_, *w.controlSet, ControlPush{k, slot, kBz, mode, groups, directionGroups, 0, 0, tolerance2}, 1);
+  const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
+  auto control = [&](std::uint32_t mode, std::uint32_t slotRz) {
+    s.dispatch(control_, *w.controlSet, ControlPush{k, slotRz, kBz, mode, groups, directionGroups, 0, 0, tolerance2},
+               1);
     s.barrier();
   };
   control(0, kRzEven);
@@ -408,9 +415,10 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
     s.barrier();
-    s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq, block_}, w.arguments, kFusedArguments);
+    s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq, block_, 1}, w.arguments,
+                       kFusedArguments);
     s.barrier();
-    s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kReduceArguments);
+    s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kPairReduceArguments);
     s.barrier();
     s.dispatchIndirect(direction_, *w.directionSet, PcgDirectionPush{n_, k, next, current}, w.arguments,
                        kDirectionArguments);
@@ -509,13 +517,24 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   const double zeros[kStateSize] = {};
   w.state.upload(zeros);
   w.innerIterationsSeen = 0.0;
+  w.uploadedTolerance = -1.0;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
   w.start.run();
 }
 
+void AdmmKernels::setLinearTolerance(double tolerance) {
+  if (!(tolerance >= 0.0)) throwUsage("ADMM: the inner solve's tolerance must be >= 0");
+  linearTolerance_ = tolerance;
+}
+
 void AdmmKernels::iterate(int count) {
   if (!workspace_ || count <= 0) return;
+  if (workspace_->uploadedTolerance != linearTolerance_) {
+    const double squared = linearTolerance_ * linearTolerance_;
+    workspace_->state.upload({&squared, 1}, kLinearTolerance2);
+    workspace_->uploadedTolerance = linearTolerance_;
+  }
   if (workspace_->singleWorkgroup) {
     iterateSingleWorkgroup(count);
     return;

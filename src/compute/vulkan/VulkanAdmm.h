@@ -17,8 +17,9 @@
 // deformation 2.5x fewer). The host inverts the small blocks at each rho update. The
 // iterations are recorded (a cap per ADMM iteration) and sized through
 // indirect dispatches by a one-thread control kernel (shaders/pcg_control.comp): once
-// every column has r.z <= tol^2 b.z the remaining recorded iterations are empty
-// dispatches. So each solve stops at the tolerance, like a host-driven PCG, without a
+// every column has r.z <= tol^2 b.z and ||r|| below the host's bound from the ADMM
+// residuals (AdmmSettings::linearToleranceFraction), the remaining recorded iterations are
+// empty dispatches. So each solve stops at the tolerance, like a host-driven PCG, without a
 // read-back. A solve that needs more than the cap continues from its warm start in the
 // next ADMM iteration (an inexact ADMM step, counted in AdmmInfo::inexactSolves); when a
 // check sees one, the cap doubles for the following blocks (re-recorded), up to
@@ -76,6 +77,7 @@ class AdmmKernels final : public compute::AdmmKernels {
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
   void iterate(int count) override;
   compute::AdmmMeasures measure() override;
+  void setLinearTolerance(double tolerance) override;
   /// Whether the current workspace (after start()) records one dispatch per block.
   bool singleWorkgroup() const;
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
@@ -116,6 +118,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
   bool longFirstSolve_ = true;       ///< The next block starts after start() or setRho().
+  double linearTolerance_ = 0.0;     ///< Bound on each column's ||r|| of the inner solves.
   std::unique_ptr<Workspace> workspace_;
 };
 

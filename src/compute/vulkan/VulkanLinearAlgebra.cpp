@@ -86,14 +86,16 @@ void DeviceVectors::download(Eigen::MatrixXd& values) const {
   data_.download({values.data(), static_cast<std::size_t>(values.size())});
 }
 
-DeviceScalars::DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN)
+DeviceScalars::DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN,
+                             std::uint32_t partialColumns)
     : slots_(slots),
       m_(m),
       // Each thread of the first pass sums at least four entries; 1024 groups keep the
       // second pass (one workgroup per column) short.
       groups_(std::clamp<std::uint32_t>((maxN + 4 * kWorkGroupSize - 1) / (4 * kWorkGroupSize), 1, 1024)),
       values_(context, static_cast<std::size_t>(slots) * m, MemoryClass::Device, "device scalars"),
-      partial_(context, static_cast<std::size_t>(groups_) * m, MemoryClass::Device, "partial sums") {
+      partial_(context, static_cast<std::size_t>(groups_) * std::max(m, partialColumns), MemoryClass::Device,
+               "partial sums") {
   groups_ = std::min(groups_, context.info().maxWorkGroupCount[0]);  // the kernels stride over the rest
 }
 

@@ -56,7 +56,10 @@ class DeviceVectors {
 /// of the dot products' first pass for vectors of up to maxN entries.
 class DeviceScalars {
  public:
-  DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN);
+  /// `partialColumns` (default m): columns of first-pass partial sums, for fused kernels
+  /// that produce two quantities per column.
+  DeviceScalars(Context& context, std::uint32_t slots, std::uint32_t m, std::uint32_t maxN,
+                std::uint32_t partialColumns = 0);
   std::uint32_t m() const { return m_; }
   /// Copy all slots to the host (after the sequence that wrote them ran).
   std::vector<double> read() const;
