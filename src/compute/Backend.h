@@ -4,6 +4,7 @@
 // Vulkan compute shaders. Algorithms never branch on the backend.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -17,6 +18,8 @@ enum class BackendKind { Cpu, Vulkan };
 
 class AdmmSolver;     // compute/Admm.h
 struct AdmmSettings;  // compute/Admm.h
+class ReducedArapKernels;   // compute/ReducedArap.h
+struct ReducedArapProblem;  // compute/ReducedArap.h
 
 /// Compressed-row sparse matrix, the layout both backends consume.
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
@@ -97,6 +100,12 @@ class Backend {
   /// the host with createSpdSolver's solver; a device backend keeps it on the device.
   virtual std::unique_ptr<AdmmSolver> createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
                                                        const AdmmSettings& settings);
+
+  /// Device kernels for subspace ASAP/ARAP iterations (compute/ReducedArap.h), or null
+  /// when this backend has none: the algorithm then runs its host kernels. `problem` is
+  /// called only by a backend that uses it (building it costs O(d^2 #V) on the host).
+  virtual std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
+      const std::function<ReducedArapProblem()>& problem);
 };
 
 /// Which backend the user asked for.

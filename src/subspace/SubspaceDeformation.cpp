@@ -1,10 +1,13 @@
 #include "subspace/SubspaceDeformation.h"
 
+#include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "compute/ReducedArap.h"
 
 namespace plano::subspace {
 namespace {
@@ -44,84 +47,172 @@ SubspaceDeformer::SubspaceDeformer(const LinearSpace& space, const PositionalCon
   if (H.rows() > 0) H.diagonal().array() += 1e-12 * std::max(H.diagonal().maxCoeff(), 1.0);
   factor_.compute(H);
   if (factor_.info() != Eigen::Success) throwNumerical("subspace deformation: factorization of the global matrix failed");
-  const std::size_t nf = static_cast<std::size_t>(Y.faceCount());
-  covariances_.resize(nf);
-  rotations_.resize(nf);
-  singularValues_.resize(nf);
+  fixedPart_ = reduced_ * constrained_.particular;
 }
 
-double SubspaceDeformer::localStep(const Positions& X) {
-  const PolygonMesh& Y = space_.source;
-  const Index nf = Y.faceCount();
-  std::vector<Eigen::Vector3d> xc, yc;
-  for (Index f = 0; f < nf; ++f) {
-    const auto face = Y.faces[f];
-    Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
-    for (Index v : face) {
-      xm += X.row(v).transpose();
-      ym += Y.vertices.row(v).transpose();
-    }
-    xm /= static_cast<double>(face.size());
-    ym /= static_cast<double>(face.size());
-    Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-    for (Index v : face) M += (X.row(v).transpose() - xm) * (Y.vertices.row(v).transpose() - ym).transpose();
-    covariances_[f] = M;
+SubspaceDeformer::~SubspaceDeformer() = default;
+
+/// The host kernels: the Eigen loop, the global step solved with the deformer's LDLT.
+class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
+ public:
+  explicit HostKernels(SubspaceDeformer& deformer) : d_(deformer) {
+    const std::size_t nf = static_cast<std::size_t>(d_.space_.source.faceCount());
+    covariances_.resize(nf);
+    rotations_.resize(nf);
+    singularValues_.resize(nf);
   }
-  backend_.closestRotations(covariances_, rotations_, singularValues_);
-  targets_ = Positions::Zero(Y.vertexCount(), 3);
-  double energy = 0.0;
-  for (Index f = 0; f < nf; ++f) {
-    const auto face = Y.faces[f];
-    Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
-    for (Index v : face) {
-      xm += X.row(v).transpose();
-      ym += Y.vertices.row(v).transpose();
+  int preferredBlock() const override { return 1; }
+  void start(const Positions& X) override { X_ = X; }
+  std::vector<compute::ReducedArapMeasures> iterate(int count) override {
+    std::vector<compute::ReducedArapMeasures> measures(count);
+    before_.resize(count);
+    for (int k = 0; k < count; ++k) {
+      before_[k] = X_;
+      measures[k].energy = localStep();
+      globalStep();
+      measures[k].constraintNorm = d_.space_.B.residual(X_);
+      measures[k].positionsNorm = X_.norm();
     }
-    xm /= static_cast<double>(face.size());
-    ym /= static_cast<double>(face.size());
-    double scale = 1.0;
-    if (settings_.energy == DeformationEnergy::Asap) {
-      double norm2 = 0.0;
-      for (Index v : face) norm2 += (Y.vertices.row(v).transpose() - ym).squaredNorm();
-      scale = norm2 > 0.0 ? singularValues_[f].sum() / norm2 : 1.0;
-    }
-    for (Index v : face) {
-      const Eigen::Vector3d t = scale * rotations_[f] * (Y.vertices.row(v).transpose() - ym);
-      targets_.row(v) += t.transpose();
-      energy += (X.row(v).transpose() - xm - t).squaredNorm();
-    }
+    return measures;
   }
-  return energy;
+  void positions(int index, Positions& X) override { X = index < static_cast<int>(before_.size()) ? before_[index] : X_; }
+
+ private:
+  /// Fills targets_ (G = sum_f P_f^T (s_f C Y_f R_f^T)), returns the energy at X_.
+  double localStep() {
+    const PolygonMesh& Y = d_.space_.source;
+    const Index nf = Y.faceCount();
+    for (Index f = 0; f < nf; ++f) {
+      const auto face = Y.faces[f];
+      Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
+      for (Index v : face) {
+        xm += X_.row(v).transpose();
+        ym += Y.vertices.row(v).transpose();
+      }
+      xm /= static_cast<double>(face.size());
+      ym /= static_cast<double>(face.size());
+      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+      for (Index v : face) M += (X_.row(v).transpose() - xm) * (Y.vertices.row(v).transpose() - ym).transpose();
+      covariances_[f] = M;
+    }
+    d_.backend_.closestRotations(covariances_, rotations_, singularValues_);
+    targets_ = Positions::Zero(Y.vertexCount(), 3);
+    double energy = 0.0;
+    for (Index f = 0; f < nf; ++f) {
+      const auto face = Y.faces[f];
+      Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
+      for (Index v : face) {
+        xm += X_.row(v).transpose();
+        ym += Y.vertices.row(v).transpose();
+      }
+      xm /= static_cast<double>(face.size());
+      ym /= static_cast<double>(face.size());
+      double scale = 1.0;
+      if (d_.settings_.energy == DeformationEnergy::Asap) {
+        double norm2 = 0.0;
+        for (Index v : face) norm2 += (Y.vertices.row(v).transpose() - ym).squaredNorm();
+        scale = norm2 > 0.0 ? singularValues_[f].sum() / norm2 : 1.0;
+      }
+      for (Index v : face) {
+        const Eigen::Vector3d t = scale * rotations_[f] * (Y.vertices.row(v).transpose() - ym);
+        targets_.row(v) += t.transpose();
+        energy += (X_.row(v).transpose() - xm - t).squaredNorm();
+      }
+    }
+    return energy;
+  }
+
+  void globalStep() {
+    const Eigen::MatrixXd& F = d_.constrained_.free;
+    Eigen::VectorXd W = d_.constrained_.particular;
+    if (F.cols() > 0) {
+      const Eigen::VectorXd rhs = F.transpose() * (d_.space_.N.coefficients(targets_) - d_.fixedPart_);
+      W += F * d_.factor_.solve(rhs);
+    }
+    X_ = d_.space_.N.shape(W);
+  }
+
+  SubspaceDeformer& d_;
+  Positions X_;
+  std::vector<Positions> before_;  ///< X before each global step of the last block.
+  Positions targets_;
+  std::vector<Eigen::Matrix3d> covariances_, rotations_;
+  std::vector<Eigen::Vector3d> singularValues_;
+};
+
+compute::ReducedArapProblem SubspaceDeformer::reducedProblem() const {
+  // x = N W with W = W0 + G (N^T g - R W0), G = F H^-1 F^T: offset N (W0 - G R W0), basis N
+  // (as a 3 #V x d matrix), projection G N^T.
+  const SubspaceBasis& N = space_.N;
+  const Index d = N.dimension();
+  const Index V = N.vertexCount();
+  Eigen::MatrixXd basis;
+  if (N.separable()) {
+    basis = Eigen::MatrixXd::Zero(3 * V, d);
+    for (Index v = 0; v < V; ++v)
+      for (Index a = 0; a < N.columns().cols(); ++a)
+        for (Index c = 0; c < 3; ++c) basis(3 * v + c, 3 * a + c) = N.columns()(v, a);
+  } else {
+    basis = N.columns();
+  }
+  const Eigen::MatrixXd& F = constrained_.free;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(d, d);
+  if (F.cols() > 0) G = F * factor_.solve(F.transpose());
+  const Eigen::VectorXd W = constrained_.particular - G * fixedPart_;
+  compute::ReducedArapProblem problem;
+  problem.faces = space_.source.faces;
+  problem.source = space_.source.vertices;
+  problem.asap = settings_.energy == DeformationEnergy::Asap;
+  problem.offset = basis * W;
+  problem.projection = G * basis.transpose();
+  problem.basis = std::move(basis);
+  problem.constraints = space_.B.fullMatrix();
+  return problem;
 }
 
 SubspaceDeformationInfo SubspaceDeformer::solve(Positions& X, const std::function<void(Index, const Positions&)>& onIterate) {
   if (X.rows() != space_.source.vertexCount() || X.cols() != 3) {
     throwUsage("subspace deformation: the warm start has the wrong size");
   }
+  std::unique_ptr<compute::ReducedArapKernels> kernels =
+      backend_.createReducedArapKernels([this] { return reducedProblem(); });
+  if (!kernels) kernels = std::make_unique<HostKernels>(*this);
+  kernels->start(X);
+
   SubspaceDeformationInfo info;
-  const Eigen::MatrixXd& F = constrained_.free;
-  const Eigen::VectorXd& W0 = constrained_.particular;
-  const Eigen::VectorXd fixedPart = reduced_ * W0;
   double previous = std::numeric_limits<double>::infinity();
-  for (Index k = 0; k < settings_.maxIterations; ++k) {
+  Index k = 0;
+  bool stopped = false;
+  Positions iterate;
+  while (!stopped && k < settings_.maxIterations) {
     throwIfCancelled("subspace deformation");
-    const double energy = localStep(X);
-    info.energy = energy;
-    if (k > 0 && previous - energy <= settings_.tolerance * std::max(previous, 1e-300)) {
-      info.status = DeformationStatus::Converged;
-      break;
+    const int count = static_cast<int>(std::min<Index>(kernels->preferredBlock(), settings_.maxIterations - k));
+    const std::vector<compute::ReducedArapMeasures> measures = kernels->iterate(count);
+    for (int j = 0; j < count; ++j, ++k) {
+      const compute::ReducedArapMeasures& m = measures[j];
+      info.energy = m.energy;
+      // The energy at X_k decides whether X_k is the answer; the global steps the kernels
+      // ran past it in this block are discarded. The warm start X_0 need not meet the
+      // constraints (the rest shape has energy 0), so the first comparison is X_2 with X_1,
+      // both global-step results, between which the energy can only decrease.
+      if (k > 1 && previous - m.energy <= settings_.tolerance * std::max(previous, 1e-300)) {
+        info.status = DeformationStatus::Converged;
+        kernels->positions(j, X);
+        stopped = true;
+        break;
+      }
+      previous = m.energy;
+      if (!std::isfinite(m.positionsNorm)) {
+        throwNumerical("subspace deformation: non-finite positions at iteration " + std::to_string(k));
+      }
+      info.iterations = k + 1;
+      info.maxSubspaceResidual = std::max(info.maxSubspaceResidual, m.constraintNorm / std::max(m.positionsNorm, 1e-300));
+      if (onIterate) {
+        kernels->positions(j + 1, iterate);
+        onIterate(k, iterate);
+      }
     }
-    previous = energy;
-    Eigen::VectorXd W = W0;
-    if (F.cols() > 0) {
-      const Eigen::VectorXd rhs = F.transpose() * (space_.N.coefficients(targets_) - fixedPart);
-      W += F * factor_.solve(rhs);
-    }
-    X = space_.N.shape(W);
-    if (!X.allFinite()) throwNumerical("subspace deformation: non-finite positions at iteration " + std::to_string(k));
-    info.iterations = k + 1;
-    info.maxSubspaceResidual = std::max(info.maxSubspaceResidual, space_.B.residual(X) / std::max(X.norm(), 1e-300));
-    if (onIterate) onIterate(k, X);
+    if (!stopped) kernels->positions(count, X);
   }
   info.constraintResidual = constrained_.constraintResidual;
   for (Index v : constraints_.fixed)

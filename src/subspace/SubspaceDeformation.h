@@ -14,6 +14,7 @@
 #include <string>
 
 #include "compute/Backend.h"
+#include "compute/ReducedArap.h"
 #include "mesh/Constraints.h"
 #include "subspace/ConstrainedSubspace.h"
 #include "subspace/LinearSpace.h"
@@ -50,16 +51,21 @@ class SubspaceDeformer {
   /// range, Error(Numerical) when the factorization fails.
   SubspaceDeformer(const LinearSpace& space, const PositionalConstraints& constraints, compute::Backend& backend,
                    const SubspaceDeformationSettings& settings = {});
+  ~SubspaceDeformer();
 
   /// Iterate from X (#V x 3, warm start; the source mesh is a good first guess) and leave
-  /// the result in X. `onIterate(k, X)` is called after every global step.
+  /// the result in X. `onIterate(k, X)` is called after every global step. The iterations
+  /// run on the backend's kernels (Backend::createReducedArapKernels) when it has them.
+  /// Throws Error(Numerical) when an iterate is not finite.
   SubspaceDeformationInfo solve(Positions& X, const std::function<void(Index, const Positions&)>& onIterate = {});
 
   Index freeDimension() const { return static_cast<Index>(constrained_.free.cols()); }
   const ConstrainedSubspace& constrained() const { return constrained_; }
 
  private:
-  double localStep(const Positions& X);  // Fills targets_, returns the energy.
+  class HostKernels;
+  /// The global step as a backend's affine map (compute/ReducedArap.h).
+  compute::ReducedArapProblem reducedProblem() const;
 
   const LinearSpace& space_;
   PositionalConstraints constraints_;
@@ -67,10 +73,8 @@ class SubspaceDeformer {
   SubspaceDeformationSettings settings_;
   ConstrainedSubspace constrained_;
   Eigen::MatrixXd reduced_;  ///< N^T (K (x) I3) N.
-  Eigen::LDLT<Eigen::MatrixXd> factor_;
-  Positions targets_;        ///< G = sum_f P_f^T (s_f C Y_f R_f^T): the global step's right-hand side.
-  std::vector<Eigen::Matrix3d> covariances_, rotations_;
-  std::vector<Eigen::Vector3d> singularValues_;
+  Eigen::LDLT<Eigen::MatrixXd> factor_;  ///< Of H = free^T reduced_ free (+ a tiny Tikhonov term).
+  Eigen::VectorXd fixedPart_;            ///< reduced_ * particular.
 };
 
 }  // namespace plano::subspace

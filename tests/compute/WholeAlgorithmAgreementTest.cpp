@@ -14,7 +14,6 @@
 #include "projective/PqSubdivision.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/SubspaceDeformation.h"
-#include "subspace/SubspaceTopology.h"
 
 namespace plano::test {
 namespace {
@@ -103,29 +102,28 @@ TEST_F(WholeAlgorithmAgreement, MultiresDeformationGivesTheCpuMeshWithTheSameIte
 }
 
 TEST_F(WholeAlgorithmAgreement, SubspaceDeformationGivesTheCpuMeshWithTheSameIterations) {
-  const PolygonMesh dome = generate::hexagonalDome(3);
+  // A vertical-space dome, its first ring fixed and one vertex pulled up: 28 free
+  // dimensions, ~25 iterations to the default tolerance (more than one device block).
+  const PolygonMesh dome = generate::hexagonalDome(2);
   const subspace::LinearSpace space = subspace::buildLinearSpace(
       dome, subspace::uniformAssignment(subspace::SpaceKind::Vertical, dome.faceCount()));
-  const subspace::SubspaceTopology topology = subspace::computeTopology(dome.faces, dome.vertexCount());
   PositionalConstraints constraints;
-  for (const auto& loop : topology.boundaryLoops) constraints.fixed.insert(constraints.fixed.end(), loop.begin(), loop.end());
-  Index top = 0;
-  dome.vertices.col(2).maxCoeff(&top);
-  const double lift = 0.05 * boundingBoxDiagonal(dome.vertices);
-  constraints.handles.push_back({top, dome.vertices.row(top).transpose() + Eigen::Vector3d(0, 0, lift)});
+  for (Index v = 0; v < 10; ++v) constraints.fixed.push_back(v);
+  constraints.handles.push_back({40, Eigen::Vector3d(0.0, 0.0, 1.2)});
 
   for (const subspace::DeformationEnergy energy : {subspace::DeformationEnergy::Asap, subspace::DeformationEnergy::Arap}) {
     subspace::SubspaceDeformationSettings settings;
     settings.energy = energy;
-    settings.maxIterations = 30;
     compute::CpuBackend cpu;
     Positions reference = dome.vertices, result = dome.vertices;
     const auto referenceInfo = subspace::SubspaceDeformer(space, constraints, cpu, settings).solve(reference);
     const auto info = subspace::SubspaceDeformer(space, constraints, backend(), settings).solve(result);
+    EXPECT_EQ(referenceInfo.status, subspace::DeformationStatus::Converged);
+    EXPECT_GT(referenceInfo.iterations, 8);
     EXPECT_EQ(info.status, referenceInfo.status);
     EXPECT_EQ(info.iterations, referenceInfo.iterations);
     EXPECT_LT(relativeDifference(result, reference), kAgreement);
-    EXPECT_GT((reference - dome.vertices).cwiseAbs().maxCoeff(), 0.1 * lift) << "the handle moved the mesh";
+    EXPECT_GT((reference - dome.vertices).cwiseAbs().maxCoeff(), 0.1) << "the handle moved the mesh";
   }
 }
 

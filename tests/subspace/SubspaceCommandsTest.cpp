@@ -120,11 +120,13 @@ TEST(SubspaceDeform, DeformsInsideTheSpaceAndReportsIterations) {
   }
   const auto result = runTool("-q deform " + quoted(dir / "dome.obj") + " --space vertical --constraints " +
                               quoted(dir / "c.json") + " -o " + quoted(dir / "out.obj") + " --report " +
-                              quoted(dir / "r.json") + " --max-iterations 20");
+                              quoted(dir / "r.json") + " --max-iterations 60");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto j = readJson(dir / "r.json");
   EXPECT_EQ(j["command"], "deform");
-  EXPECT_GT(j["iterations"].get<int>(), 0);
+  // Not a stop after the first global step: the start (the rest shape, energy 0) is no
+  // reference for the energy's decrease.
+  EXPECT_GT(j["iterations"].get<int>(), 2);
   // Every iterate lies in null(B): the residual is at rounding level (OBJ round trips are exact).
   EXPECT_LE(j["max_subspace_residual"].get<double>(), 1e-8);
   const auto bad = runTool("-q deform " + quoted(dir / "dome.obj") + " --space affine --constraints " +

@@ -6,6 +6,7 @@
 #include "compute/vulkan/VulkanFacePlanarity.h"
 #include "compute/vulkan/VulkanPcgSolver.h"
 #include "compute/vulkan/VulkanProjectiveFit.h"
+#include "compute/vulkan/VulkanReducedArap.h"
 #include "core/Error.h"
 
 namespace plano::compute {
@@ -44,6 +45,11 @@ std::unique_ptr<AdmmSolver> VulkanBackend::createAdmmSolver(const SparseMatrix& 
                                                            const AdmmSettings& settings) {
   return std::make_unique<AdmmSolver>(std::make_unique<vk::AdmmKernels>(*context_, P, C, settings), P.rows(),
                                       C.rows(), settings);
+}
+
+std::unique_ptr<ReducedArapKernels> VulkanBackend::createReducedArapKernels(
+    const std::function<ReducedArapProblem()>& problem) {
+  return std::make_unique<vk::ReducedArapKernels>(*context_, problem());
 }
 
 std::unique_ptr<Backend> createVulkanBackend(VulkanDevicePreference preference) {

@@ -42,6 +42,11 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<AdmmSolver> createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
                                                const AdmmSettings& settings) override;
 
+  /// Subspace ASAP/ARAP iterations on the device (vk::ReducedArapKernels): a few scalars
+  /// per iteration come back. Must not outlive the backend.
+  std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
+      const std::function<ReducedArapProblem()>& problem) override;
+
   /// The device context (device properties, validation messages).
   vk::Context& context() { return *context_; }
 
