@@ -8,9 +8,10 @@
 // submit, so that only a few scalars per iteration come back.
 //
 // For a backend, the global step is an affine map of the local step's per-vertex targets
-// g (vec, rows 3 v + c):  x = offset + basis (projection g), basis 3 #V x d and projection
-// d x 3 #V. This holds every constraint and the space's structure, so the kernels need no
-// knowledge of either.
+// g (vec, rows 3 v + c):  x = offset + N (G (N^T g)), with N the space's basis (3 #V x d,
+// sparse where the space is separable) and G (d x d) the constrained solve. This holds
+// every constraint and the space's structure, so the kernels need no knowledge of either,
+// and it costs O(#V d + d^2) memory (a product N G N^T would be O(#V d) dense twice over).
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
@@ -24,8 +25,8 @@ struct ReducedArapProblem {
   FaceList faces;
   Positions source;            ///< The rest shape Y (#V x 3).
   bool asap = true;            ///< Per-face scale (similarity) or 1 (rigid).
-  Eigen::MatrixXd basis;       ///< 3 #V x d.
-  Eigen::MatrixXd projection;  ///< d x 3 #V.
+  SparseMatrix basis;          ///< N, 3 #V x d.
+  Eigen::MatrixXd gain;        ///< G, d x d.
   Eigen::VectorXd offset;      ///< 3 #V.
   SparseMatrix constraints;    ///< B (rows x 3 #V): every iterate's ||B x|| is measured.
 };

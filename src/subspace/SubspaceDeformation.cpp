@@ -142,30 +142,37 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
 
 compute::ReducedArapProblem SubspaceDeformer::reducedProblem() const {
   // x = N W with W = W0 + G (N^T g - R W0), G = F H^-1 F^T: offset N (W0 - G R W0), basis N
-  // (as a 3 #V x d matrix), projection G N^T.
+  // (as a 3 #V x d matrix: coefficient 3 a + c of a separable space moves coordinate c
+  // along scalar column a), gain G.
   const SubspaceBasis& N = space_.N;
   const Index d = N.dimension();
   const Index V = N.vertexCount();
-  Eigen::MatrixXd basis;
-  if (N.separable()) {
-    basis = Eigen::MatrixXd::Zero(3 * V, d);
-    for (Index v = 0; v < V; ++v)
-      for (Index a = 0; a < N.columns().cols(); ++a)
-        for (Index c = 0; c < 3; ++c) basis(3 * v + c, 3 * a + c) = N.columns()(v, a);
-  } else {
-    basis = N.columns();
+  const Eigen::MatrixXd& columns = N.columns();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<std::size_t>(columns.size()) * (N.separable() ? 3 : 1));
+  for (Index a = 0; a < columns.cols(); ++a) {
+    for (Index r = 0; r < columns.rows(); ++r) {
+      const double value = columns(r, a);
+      if (value == 0.0) continue;
+      if (N.separable()) {
+        for (Index c = 0; c < 3; ++c) entries.emplace_back(3 * r + c, 3 * a + c, value);
+      } else {
+        entries.emplace_back(r, a, value);
+      }
+    }
   }
-  const Eigen::MatrixXd& F = constrained_.free;
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(d, d);
-  if (F.cols() > 0) G = F * factor_.solve(F.transpose());
-  const Eigen::VectorXd W = constrained_.particular - G * fixedPart_;
   compute::ReducedArapProblem problem;
+  problem.basis.resize(3 * V, d);
+  problem.basis.setFromTriplets(entries.begin(), entries.end());
+  problem.basis.makeCompressed();
+  const Eigen::MatrixXd& F = constrained_.free;
+  problem.gain = Eigen::MatrixXd::Zero(d, d);
+  if (F.cols() > 0) problem.gain = F * factor_.solve(F.transpose());
+  const Eigen::VectorXd W = constrained_.particular - problem.gain * fixedPart_;
+  problem.offset = problem.basis * W;
   problem.faces = space_.source.faces;
   problem.source = space_.source.vertices;
   problem.asap = settings_.energy == DeformationEnergy::Asap;
-  problem.offset = basis * W;
-  problem.projection = G * basis.transpose();
-  problem.basis = std::move(basis);
   problem.constraints = space_.B.fullMatrix();
   return problem;
 }
@@ -174,9 +181,11 @@ SubspaceDeformationInfo SubspaceDeformer::solve(Positions& X, const std::functio
   if (X.rows() != space_.source.vertexCount() || X.cols() != 3) {
     throwUsage("subspace deformation: the warm start has the wrong size");
   }
-  std::unique_ptr<compute::ReducedArapKernels> kernels =
-      backend_.createReducedArapKernels([this] { return reducedProblem(); });
-  if (!kernels) kernels = std::make_unique<HostKernels>(*this);
+  if (!kernels_) {  // once per deformer: a backend uploads the problem only once
+    kernels_ = backend_.createReducedArapKernels([this] { return reducedProblem(); });
+    if (!kernels_) kernels_ = std::make_unique<HostKernels>(*this);
+  }
+  compute::ReducedArapKernels* kernels = kernels_.get();
   kernels->start(X);
 
   SubspaceDeformationInfo info;

@@ -11,6 +11,7 @@
 // hence exactly in the space: exactly polyhedral, not just at convergence.
 #include <Eigen/Dense>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "compute/Backend.h"
@@ -75,6 +76,7 @@ class SubspaceDeformer {
   Eigen::MatrixXd reduced_;  ///< N^T (K (x) I3) N.
   Eigen::LDLT<Eigen::MatrixXd> factor_;  ///< Of H = free^T reduced_ free (+ a tiny Tikhonov term).
   Eigen::VectorXd fixedPart_;            ///< reduced_ * particular.
+  std::unique_ptr<compute::ReducedArapKernels> kernels_;  ///< The backend's, or HostKernels; made by the first solve.
 };
 
 }  // namespace plano::subspace

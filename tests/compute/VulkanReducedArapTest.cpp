@@ -56,8 +56,9 @@ TEST_F(VulkanReducedArap, TheBackendRunsTheIterationsOnTheDevice) {
   problem.faces.addFace({0, 1, 2, 3});
   problem.source.resize(4, 3);
   problem.source << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
-  problem.basis = Eigen::MatrixXd::Identity(12, 12);
-  problem.projection = Eigen::MatrixXd::Identity(12, 12);
+  problem.basis.resize(12, 12);
+  problem.basis.setIdentity();
+  problem.gain = Eigen::MatrixXd::Identity(12, 12);
   problem.offset = Eigen::VectorXd::Zero(12);
   problem.constraints = compute::SparseMatrix(0, 12);
   problem.asap = true;

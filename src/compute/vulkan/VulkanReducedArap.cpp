@@ -21,14 +21,8 @@ std::uint32_t count32(Eigen::Index value, const char* what) {
   return static_cast<std::uint32_t>(value);
 }
 
-/// A dense matrix as CSR for the device's SpMV (exact zeros dropped). An all-zero matrix
-/// keeps one explicit zero: the device has no empty buffers.
-compute::SparseMatrix csr(const Eigen::MatrixXd& dense) {
-  compute::SparseMatrix A = dense.sparseView(0.0, 0.0);
-  if (A.nonZeros() == 0) A.coeffRef(0, 0) = 0.0;
-  A.makeCompressed();
-  return A;
-}
+/// A dense matrix as CSR for the device's SpMV (exact zeros dropped).
+compute::SparseMatrix csr(const Eigen::MatrixXd& dense) { return dense.sparseView(0.0, 0.0); }
 
 /// S (3 #V x 3 #corners): row 3 v + c sums coordinate c of every corner of vertex v.
 compute::SparseMatrix cornerGather(const FaceList& faces, Index vertexCount) {
@@ -49,18 +43,18 @@ std::vector<std::int32_t> toInt32(const std::vector<Index>& values) {
 
 /// A space of dimension 0 (every vertex pinned) still gets one zero coefficient, and a
 /// mesh without constraint rows one zero row: the device has no empty buffers.
-compute::SparseMatrix nonEmpty(const Eigen::MatrixXd& A, Eigen::Index rows, Eigen::Index cols) {
-  return csr(A.size() > 0 ? A : Eigen::MatrixXd::Zero(std::max<Eigen::Index>(rows, 1), std::max<Eigen::Index>(cols, 1)));
-}
-compute::SparseMatrix nonEmpty(const compute::SparseMatrix& A) {
-  return A.rows() > 0 ? A : csr(Eigen::MatrixXd::Zero(1, A.cols()));
+compute::SparseMatrix nonEmpty(compute::SparseMatrix A) {
+  if (A.rows() == 0 || A.cols() == 0) A.resize(std::max<Eigen::Index>(A.rows(), 1), std::max<Eigen::Index>(A.cols(), 1));
+  if (A.nonZeros() == 0) A.coeffRef(0, 0) = 0.0;
+  A.makeCompressed();
+  return A;
 }
 
 const compute::ReducedArapProblem& checked(const compute::ReducedArapProblem& p) {
   const Eigen::Index n = 3 * p.source.rows();
   const Eigen::Index d = p.basis.cols();
   if (p.faces.size() == 0 || p.source.rows() == 0) throwUsage("subspace deformation: an empty mesh");
-  if (p.basis.rows() != n || p.projection.rows() != d || p.projection.cols() != n || p.offset.size() != n ||
+  if (p.basis.rows() != n || p.gain.rows() != d || p.gain.cols() != d || p.offset.size() != n ||
       p.constraints.cols() != n) {
     throwUsage("subspace deformation: the global step's matrices do not match the mesh's " +
                std::to_string(p.source.rows()) + " vertices");
@@ -91,12 +85,14 @@ ReducedArapKernels::ReducedArapKernels(Context& context, const compute::ReducedA
       vertexTargets_(context, 3 * vertices_, 1, "vertex targets"),
       coefficients_(context, count32(std::max<Eigen::Index>(problem.basis.cols(), 1), "dimension"), 1,
                     "subspace coefficients"),
+      gained_(context, coefficients_.n(), 1, "constrained coefficients"),
       offset_(context, 3 * vertices_, 1, "global step offset"),
       Bx_(context, count32(std::max<Eigen::Index>(problem.constraints.rows(), 1), "constraint rows"), 1,
           "constraint values"),
       gather_(context, cornerGather(problem.faces, vertices_)),
-      projection_(context, nonEmpty(problem.projection, 1, 3 * vertices_)),
-      basis_(context, nonEmpty(problem.basis, 3 * vertices_, 1)),
+      basis_(context, nonEmpty(problem.basis)),
+      basisTransposed_(context, nonEmpty(problem.basis.transpose())),
+      gain_(context, nonEmpty(csr(problem.gain))),
       constraints_(context, nonEmpty(problem.constraints)),
       measures_(context, 3 * kBlock, 1, std::max({3 * vertices_, faces_, static_cast<std::uint32_t>(Bx_.n())})) {
   faceOffsets_.upload(toInt32(problem.faces.offsets()));
@@ -142,10 +138,11 @@ Sequence& ReducedArapKernels::block(int count) {
     s.barrier();
     la.dot(s, faceEnergy_, ones_, measures_, slotBase);
     la.copy(s, x_, before_[j]);
-    // Global step: x = offset + basis (projection (S t)).
+    // Global step: x = offset + N (G (N^T (S t))).
     la.spmv(s, gather_, cornerTargets_, vertexTargets_);
-    la.spmv(s, projection_, vertexTargets_, coefficients_);
-    la.spmv(s, basis_, coefficients_, x_);
+    la.spmv(s, basisTransposed_, vertexTargets_, coefficients_);
+    la.spmv(s, gain_, coefficients_, gained_);
+    la.spmv(s, basis_, gained_, x_);
     la.axpby(s, 1.0, offset_, 1.0, x_);
     la.spmv(s, constraints_, x_, Bx_);
     la.dot(s, Bx_, Bx_, measures_, slotBase + 1);

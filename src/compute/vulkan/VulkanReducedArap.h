@@ -4,7 +4,7 @@
 // matrices live on the device; a block of iterations is one recorded submit:
 //   covariances (arap_local_step, mode 0) -> closest rotations (closest_rotations)
 //   -> corner targets and face energies (mode 1) -> vertex targets g = S t (S sums a
-//   vertex's corners) -> x = offset + basis (projection g) -> ||B x||, ||x||.
+//   vertex's corners) -> x = offset + N (G (N^T g)) -> ||B x||, ||x||.
 // Per iteration three scalars come back (energy, ||B x||^2, ||x||^2), once per block. The
 // positions before each global step are kept on the device (one copy per iteration of the
 // block), so the host's stopping test can take any of them without re-running.
@@ -52,12 +52,14 @@ class ReducedArapKernels final : public compute::ReducedArapKernels {
   DeviceVectors faceEnergy_;
   DeviceVectors ones_;           ///< #F ones: the energy is faceEnergy . ones.
   DeviceVectors vertexTargets_;  ///< g, 3 #V.
-  DeviceVectors coefficients_;   ///< projection g, d.
+  DeviceVectors coefficients_;   ///< N^T g, d.
+  DeviceVectors gained_;         ///< G N^T g, d.
   DeviceVectors offset_;
   DeviceVectors Bx_;
   DeviceCsrMatrix gather_;       ///< S: 3 #V x 3 #corners.
-  DeviceCsrMatrix projection_;
-  DeviceCsrMatrix basis_;
+  DeviceCsrMatrix basis_;        ///< N.
+  DeviceCsrMatrix basisTransposed_;
+  DeviceCsrMatrix gain_;         ///< G (dense, as CSR).
   DeviceCsrMatrix constraints_;
   DeviceScalars measures_;       ///< 3 per iteration of a block.
   std::vector<std::unique_ptr<Sequence>> blocks_;  ///< Recorded blocks by iteration count.
