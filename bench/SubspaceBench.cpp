@@ -70,7 +70,7 @@ void BM_Eigenshapes(benchmark::State& state, SpaceKind kind) {
 
 /// One local/global iteration, after the precomputation (which is reported separately
 /// as BM_DeformationPrecompute).
-void BM_DeformationIteration(benchmark::State& state, SpaceKind kind, compute::BackendChoice choice) {
+void BM_SubspaceDeformationIteration(benchmark::State& state, SpaceKind kind, compute::BackendChoice choice) {
   compute::Backend* backend = bench::backendOrSkip(state, choice);
   if (!backend) return;
   const bench::MemoryCounters memory(state, backend);
@@ -135,13 +135,13 @@ BENCHMARK_CAPTURE(BM_Eigenshapes, parallel, SpaceKind::Parallel)->Arg(1024)->Arg
 
 BENCHMARK_CAPTURE(BM_DeformationPrecompute, affine, SpaceKind::Affine)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_DeformationIteration, affine/cpu, SpaceKind::Affine, compute::BackendChoice::Cpu)
+BENCHMARK_CAPTURE(BM_SubspaceDeformationIteration, affine/cpu, SpaceKind::Affine, compute::BackendChoice::Cpu)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_DeformationIteration, affine/vulkan, SpaceKind::Affine, compute::BackendChoice::Vulkan)
+BENCHMARK_CAPTURE(BM_SubspaceDeformationIteration, affine/vulkan, SpaceKind::Affine, compute::BackendChoice::Vulkan)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_DeformationIteration, parallel/cpu, SpaceKind::Parallel, compute::BackendChoice::Cpu)
+BENCHMARK_CAPTURE(BM_SubspaceDeformationIteration, parallel/cpu, SpaceKind::Parallel, compute::BackendChoice::Cpu)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_DeformationIteration, parallel/vulkan, SpaceKind::Parallel, compute::BackendChoice::Vulkan)
+BENCHMARK_CAPTURE(BM_SubspaceDeformationIteration, parallel/vulkan, SpaceKind::Parallel, compute::BackendChoice::Vulkan)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

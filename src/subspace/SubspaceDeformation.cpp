@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "core/Cancellation.h"
@@ -60,6 +61,8 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
     covariances_.resize(nf);
     rotations_.resize(nf);
     singularValues_.resize(nf);
+    xCentroids_.resize(nf);
+    yCentroids_.resize(nf);
   }
   int preferredBlock() const override { return 1; }
   void start(const Positions& X) override { X_ = X; }
@@ -84,15 +87,12 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
     const Index nf = Y.faceCount();
     for (Index f = 0; f < nf; ++f) {
       const auto face = Y.faces[f];
-      Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
-      for (Index v : face) {
-        xm += X_.row(v).transpose();
-        ym += Y.vertices.row(v).transpose();
-      }
-      xm /= static_cast<double>(face.size());
-      ym /= static_cast<double>(face.size());
+      centroid(face, X_, xCentroids_[f]);
+      centroid(face, Y.vertices, yCentroids_[f]);
       Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-      for (Index v : face) M += (X_.row(v).transpose() - xm) * (Y.vertices.row(v).transpose() - ym).transpose();
+      for (Index v : face) {
+        M += (X_.row(v).transpose() - xCentroids_[f]) * (Y.vertices.row(v).transpose() - yCentroids_[f]).transpose();
+      }
       covariances_[f] = M;
     }
     d_.backend_.closestRotations(covariances_, rotations_, singularValues_);
@@ -100,13 +100,8 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
     double energy = 0.0;
     for (Index f = 0; f < nf; ++f) {
       const auto face = Y.faces[f];
-      Eigen::Vector3d xm = Eigen::Vector3d::Zero(), ym = Eigen::Vector3d::Zero();
-      for (Index v : face) {
-        xm += X_.row(v).transpose();
-        ym += Y.vertices.row(v).transpose();
-      }
-      xm /= static_cast<double>(face.size());
-      ym /= static_cast<double>(face.size());
+      const Eigen::Vector3d& xm = xCentroids_[f];
+      const Eigen::Vector3d& ym = yCentroids_[f];
       double scale = 1.0;
       if (d_.settings_.energy == DeformationEnergy::Asap) {
         double norm2 = 0.0;
@@ -120,6 +115,12 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
       }
     }
     return energy;
+  }
+
+  static void centroid(std::span<const Index> face, const Positions& P, Eigen::Vector3d& out) {
+    out.setZero();
+    for (Index v : face) out += P.row(v).transpose();
+    out /= static_cast<double>(face.size());
   }
 
   void globalStep() {
@@ -138,6 +139,7 @@ class SubspaceDeformer::HostKernels final : public compute::ReducedArapKernels {
   Positions targets_;
   std::vector<Eigen::Matrix3d> covariances_, rotations_;
   std::vector<Eigen::Vector3d> singularValues_;
+  std::vector<Eigen::Vector3d> xCentroids_, yCentroids_;  ///< Per face, of X_ and the rest shape.
 };
 
 compute::ReducedArapProblem SubspaceDeformer::reducedProblem() const {

@@ -1,0 +1,59 @@
+// `plano --backend vulkan deform --space ...`: the subspace deformation's iterations run on
+// the device (vk::ReducedArapKernels) and give the CPU's mesh and iteration count; a device
+// lost in the middle exits with 5 and writes no mesh.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "mesh/Generators.h"
+#include "mesh/MeshIO.h"
+#include "support/ScopedEnvironment.h"
+#include "support/TestMeshes.h"
+
+namespace plano::test {
+namespace {
+
+class VulkanSubspaceCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    writeMesh(dir_ / "dome.obj", generate::hexagonalDome(2));
+    std::ofstream(dir_ / "c.json") << R"({"fixed": [0, 1, 2, 3, 4, 5, 6, 7, 8, 9],
+                                           "handles": [{"vertex": 40, "position": [0.0, 0.0, 1.2]}]})";
+  }
+  std::string path(const std::string& name) const { return "\"" + (dir_ / name).string() + "\""; }
+  ToolResult deform(const std::string& backend, const std::string& out, const std::string& report) const {
+    return runTool("-q --backend " + backend + " deform " + path("dome.obj") + " --space vertical --constraints " +
+                   path("c.json") + " -o " + path(out) + " --report " + path(report));
+  }
+  nlohmann::json report(const std::string& name) const {
+    std::ifstream in(dir_ / name);
+    return nlohmann::json::parse(in);
+  }
+  TempDir dir_;
+};
+
+TEST_F(VulkanSubspaceCommand, DeviceDeformationWritesTheCpuMesh) {
+  const ToolResult cpu = deform("cpu", "cpu.obj", "cpu.json");
+  const ToolResult device = deform("vulkan", "device.obj", "device.json");
+  ASSERT_EQ(cpu.exitCode, 0) << cpu.err;
+  ASSERT_EQ(device.exitCode, 0) << device.err;
+  EXPECT_EQ(report("device.json")["iterations"], report("cpu.json")["iterations"]);
+  EXPECT_GT(report("cpu.json")["iterations"].get<int>(), 8) << "more than one device block";
+  const PolygonMesh a = readMesh(dir_ / "cpu.obj");
+  const PolygonMesh b = readMesh(dir_ / "device.obj");
+  ASSERT_EQ(a.vertexCount(), b.vertexCount());
+  EXPECT_LT((a.vertices - b.vertices).rowwise().norm().maxCoeff(), 1e-9 * boundingBoxDiagonal(a.vertices));
+}
+
+TEST_F(VulkanSubspaceCommand, LostDeviceDuringDeformationExitsWithFiveAndWritesNoMesh) {
+  ScopedEnvironment fault("PLANO_VULKAN_SIMULATE_DEVICE_LOST", "3");
+  const ToolResult result = deform("vulkan", "out.obj", "r.json");
+  EXPECT_EQ(result.exitCode, 5) << result.err;
+  EXPECT_NE(result.err.find("device lost"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out.obj"));
+  EXPECT_EQ(report("r.json")["status"], "device_failure");
+}
+
+}  // namespace
+}  // namespace plano::test
