@@ -53,6 +53,9 @@ class SubspaceDeformer {
   SubspaceDeformer(const LinearSpace& space, const PositionalConstraints& constraints, compute::Backend& backend,
                    const SubspaceDeformationSettings& settings = {});
   ~SubspaceDeformer();
+  // The kernels made by solve() refer to this object.
+  SubspaceDeformer(const SubspaceDeformer&) = delete;
+  SubspaceDeformer& operator=(const SubspaceDeformer&) = delete;
 
   /// Iterate from X (#V x 3, warm start; the source mesh is a good first guess) and leave
   /// the result in X. `onIterate(k, X)` is called after every global step. The iterations
