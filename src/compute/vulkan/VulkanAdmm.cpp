@@ -68,11 +68,6 @@ std::uint32_t singleWorkgroupSize(const Context& context) { return isCpuDevice(c
 // pcg_control's indirect arguments (byte offsets of its four triples).
 constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24, kPairReduceArguments = 36;
 
-std::uint32_t count32(Eigen::Index value, const char* what) {
-  if (value < 0 || value > 0x7fffffff) throwDevice(std::string("Vulkan ADMM: ") + what + " too large");
-  return static_cast<std::uint32_t>(value);
-}
-
 std::uint32_t blockSize(int block, std::uint32_t n) {
   if (block < 1 || block > 4 || n % static_cast<std::uint32_t>(block) != 0) {
     throwUsage("ADMM: preconditioner blocks of " + std::to_string(block) + " rows for " + std::to_string(n) +
@@ -184,8 +179,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
                          std::uint32_t unitsPerDispatch)
     : context_(context),
       settings_(settings),
-      n_(count32(P.rows(), "n")),
-      m_(count32(C.rows(), "m")),
+      n_(elementCount(P.rows(), "the ADMM's unknown count")),
+      m_(elementCount(C.rows(), "the ADMM's constraint count")),
       C_(C),
       Ct_(C.transpose()),
       K0_(unionPatternK0(P, C, settings.sigma)),
@@ -502,7 +497,7 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
 
 void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                         const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
-  const auto k = count32(q.cols(), "k");
+  const auto k = elementCount(q.cols(), "the ADMM's column count");
   if (k == 0) {  // nothing to iterate; measure() reports empty norms
     workspace_.reset();
     return;

@@ -39,16 +39,19 @@ void requireSameShape(const DeviceVectors& a, const DeviceVectors& b, const char
   }
 }
 
-std::uint32_t checkedCount(std::size_t count, const char* what) {
-  if (count > 0xffffffffu) throwDevice(std::string("Vulkan: ") + what + " has more than 2^32 entries");
-  return static_cast<std::uint32_t>(count);
-}
-
 }  // namespace
 
+std::uint32_t elementCount(std::int64_t value, const char* what) {
+  if (value < 0 || value > 0x7fffffff) {
+    throwDevice(std::string("Vulkan: ") + what + " of " + std::to_string(value) +
+                " exceeds the 2^31 - 1 elements the kernels can index");
+  }
+  return static_cast<std::uint32_t>(value);
+}
+
 DeviceCsrMatrix::DeviceCsrMatrix(Context& context, const compute::SparseMatrix& A)
-    : rows_(checkedCount(A.rows(), "the matrix")),
-      cols_(checkedCount(A.cols(), "the matrix")),
+    : rows_(elementCount(A.rows(), "the matrix's row count")),
+      cols_(elementCount(A.cols(), "the matrix's column count")),
       rowOffsets_(context, A.rows() + 1, MemoryClass::Device, "CSR row offsets"),
       columns_(context, A.nonZeros(), MemoryClass::Device, "CSR column indices"),
       values_(context, A.nonZeros(), MemoryClass::Device, "CSR values") {

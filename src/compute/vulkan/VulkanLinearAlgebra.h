@@ -15,6 +15,10 @@
 
 namespace plano::vk {
 
+/// `value` as a kernel's element count: the shaders index with 32-bit signed integers,
+/// so counts above 2^31 - 1 (or negative) are Error(Device) naming `what`.
+std::uint32_t elementCount(std::int64_t value, const char* what);
+
 /// A compressed-row matrix on the device (uploaded once).
 class DeviceCsrMatrix {
  public:

@@ -16,11 +16,6 @@ struct RotationsPush {
   std::uint32_t count;
 };
 
-std::uint32_t count32(Eigen::Index value, const char* what) {
-  if (value < 0 || value > 0x3fffffff) throwDevice(std::string("Vulkan subspace deformation: ") + what + " too large");
-  return static_cast<std::uint32_t>(value);
-}
-
 /// A dense matrix as CSR for the device's SpMV (exact zeros dropped).
 compute::SparseMatrix csr(const Eigen::MatrixXd& dense) { return dense.sparseView(0.0, 0.0); }
 
@@ -66,8 +61,8 @@ const compute::ReducedArapProblem& checked(const compute::ReducedArapProblem& p)
 
 ReducedArapKernels::ReducedArapKernels(Context& context, const compute::ReducedArapProblem& problem)
     : context_(context),
-      vertices_(count32(checked(problem).source.rows(), "vertex count")),
-      faces_(count32(problem.faces.size(), "face count")),
+      vertices_(elementCount(3 * checked(problem).source.rows(), "the coordinate count") / 3),
+      faces_(elementCount(9 * problem.faces.size(), "the face covariances' entry count") / 9),
       asap_(problem.asap),
       algebra_(context),
       localStep_(context, "arap_local_step", 9, sizeof(LocalStepPush)),
@@ -79,15 +74,16 @@ ReducedArapKernels::ReducedArapKernels(Context& context, const compute::ReducedA
       covariances_(context, 9 * faces_, 1, "face covariances"),
       rotationMatrices_(context, 9 * faces_, 1, "face rotations"),
       singular_(context, 3 * faces_, 1, "face singular values"),
-      cornerTargets_(context, count32(3 * problem.faces.cornerCount(), "corner count"), 1, "corner targets"),
+      cornerTargets_(context, elementCount(3 * problem.faces.cornerCount(), "the corner coordinate count"), 1,
+                     "corner targets"),
       faceEnergy_(context, faces_, 1, "face energies"),
       ones_(context, faces_, 1, "ones"),
       vertexTargets_(context, 3 * vertices_, 1, "vertex targets"),
-      coefficients_(context, count32(std::max<Eigen::Index>(problem.basis.cols(), 1), "dimension"), 1,
+      coefficients_(context, elementCount(std::max<Eigen::Index>(problem.basis.cols(), 1), "the dimension"), 1,
                     "subspace coefficients"),
       gained_(context, coefficients_.n(), 1, "constrained coefficients"),
       offset_(context, 3 * vertices_, 1, "global step offset"),
-      Bx_(context, count32(std::max<Eigen::Index>(problem.constraints.rows(), 1), "constraint rows"), 1,
+      Bx_(context, elementCount(std::max<Eigen::Index>(problem.constraints.rows(), 1), "the constraint row count"), 1,
           "constraint values"),
       gather_(context, cornerGather(problem.faces, vertices_)),
       basis_(context, nonEmpty(problem.basis)),
@@ -101,6 +97,14 @@ ReducedArapKernels::ReducedArapKernels(Context& context, const compute::ReducedA
   offset_.upload(problem.offset);
   ones_.upload(Eigen::VectorXd::Ones(faces_));
   for (int i = 0; i < kBlock; ++i) before_.emplace_back(context, 3 * vertices_, 1, "positions before a global step");
+  localSet_ = std::make_unique<DescriptorSet>(
+      context, localStep_,
+      std::initializer_list<BufferRange>{faceOffsets_, faceIndices_, x_.data(), source_.data(), covariances_.data(),
+                                         rotationMatrices_.data(), singular_.data(), cornerTargets_.data(),
+                                         faceEnergy_.data()});
+  rotationSet_ = std::make_unique<DescriptorSet>(
+      context, rotations_,
+      std::initializer_list<BufferRange>{covariances_.data(), rotationMatrices_.data(), singular_.data()});
   blocks_.resize(kBlock + 1);
 }
 
@@ -123,18 +127,11 @@ Sequence& ReducedArapKernels::block(int count) {
   for (int j = 0; j < count; ++j) {
     const std::uint32_t slotBase = 3 * static_cast<std::uint32_t>(j);
     // Local step: covariances, rotations, targets and energies.
-    s.dispatch(localStep_,
-               {faceOffsets_, faceIndices_, x_.data(), source_.data(), covariances_.data(), rotationMatrices_.data(),
-                singular_.data(), cornerTargets_.data(), faceEnergy_.data()},
-               LocalStepPush{faces_, 0, asap_ ? 1u : 0u}, faceGroups);
+    s.dispatch(localStep_, *localSet_, LocalStepPush{faces_, 0, asap_ ? 1u : 0u}, faceGroups);
     s.barrier();
-    s.dispatch(rotations_, {covariances_.data(), rotationMatrices_.data(), singular_.data()}, RotationsPush{faces_},
-               faceGroups);
+    s.dispatch(rotations_, *rotationSet_, RotationsPush{faces_}, faceGroups);
     s.barrier();
-    s.dispatch(localStep_,
-               {faceOffsets_, faceIndices_, x_.data(), source_.data(), covariances_.data(), rotationMatrices_.data(),
-                singular_.data(), cornerTargets_.data(), faceEnergy_.data()},
-               LocalStepPush{faces_, 1, asap_ ? 1u : 0u}, faceGroups);
+    s.dispatch(localStep_, *localSet_, LocalStepPush{faces_, 1, asap_ ? 1u : 0u}, faceGroups);
     s.barrier();
     la.dot(s, faceEnergy_, ones_, measures_, slotBase);
     la.copy(s, x_, before_[j]);

@@ -62,6 +62,7 @@ class ReducedArapKernels final : public compute::ReducedArapKernels {
   DeviceCsrMatrix gain_;         ///< G (dense, as CSR).
   DeviceCsrMatrix constraints_;
   DeviceScalars measures_;       ///< 3 per iteration of a block.
+  std::unique_ptr<DescriptorSet> localSet_, rotationSet_;  ///< Built once: every block binds the same buffers.
   std::vector<std::unique_ptr<Sequence>> blocks_;  ///< Recorded blocks by iteration count.
   int lastCount_ = 0;
 };
