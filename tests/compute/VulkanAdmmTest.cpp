@@ -131,7 +131,9 @@ void expectAgreement(const AdmmRun& device, const AdmmRun& host, const compute::
   // Inner solves stopped by the recorded cap are allowed (the cap grows after them), but
   // they stay a small fraction of the solves (not so for a weaker preconditioner run as
   // a baseline).
-  if (!baseline) EXPECT_LE(device.info.inexactSolves, device.info.iterations / 3);
+  if (!baseline) {
+    EXPECT_LE(device.info.inexactSolves, device.info.iterations / 3);
+  }
   EXPECT_LT(relativeDifference(device.x, host.x), tolerance);
   EXPECT_LT(relativeDifference(device.y, host.y), tolerance * 1e2);
 }
@@ -432,6 +434,22 @@ TEST_F(VulkanAdmm, PreconditionerBlocksThatDoNotDivideTheUnknownsAreAUsageError)
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Usage);
     EXPECT_NE(std::string(e.what()).find("blocks of 4 rows for 30 unknowns"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VulkanAdmm, KThatIsNotPositiveDefiniteIsANumericalErrorNamingItsBlock) {
+  // P = -I on rows 8..11 (block 2 of 4 rows): no sigma or rho makes K definite there.
+  BoxQp qp = randomBoxQp(16, 6, 5);
+  for (int r = 8; r < 12; ++r) qp.P.coeffRef(r, r) = -100.0;
+  compute::AdmmSettings settings;
+  settings.preconditionerBlock = 4;
+  vk::AdmmKernels kernels(context(), qp.P, qp.C, settings);
+  try {
+    kernels.setRho(std::vector<char>(6, 0), 0.1);
+    ADD_FAILURE() << "an indefinite K was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("rows 8 to 11 of K is not positive definite"), std::string::npos) << e.what();
   }
 }
 

@@ -1,9 +1,12 @@
-// Device linear algebra against Eigen: SpMV, dot, axpby, row scaling and box projection
-// to 1e-12 relative.
+// Device linear algebra against Eigen: SpMV, dot, axpby, row scaling, box projection and
+// the block-Jacobi inverses to 1e-12 relative.
 #include "compute/vulkan/VulkanLinearAlgebra.h"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "compute/MeshMatrices.h"
@@ -100,6 +103,63 @@ TEST_F(VulkanLinearAlgebra, BlockDiagonalProductMatchesEigenForEveryBlockSize) {
     y.download(Y);
     EXPECT_LT(relativeError(Y, expected), 1e-12);
   }
+}
+
+/// The device's inverse diagonal blocks and the failing block (~0u: none).
+std::pair<std::vector<double>, std::uint32_t> invertBlocksOnDevice(vk::Context& context, vk::LinearAlgebra& algebra,
+                                                                   const compute::SparseMatrix& A, std::uint32_t b) {
+  vk::DeviceCsrMatrix deviceA(context, A);
+  vk::Array<double> inverses(context, static_cast<std::size_t>(A.rows()) * b, vk::MemoryClass::Device, "inverses");
+  vk::Array<std::uint32_t> failure(context, 1, vk::MemoryClass::Host, "failure");
+  const std::uint32_t none = ~0u;
+  failure.upload({&none, 1});
+  vk::Sequence s(context);
+  s.begin();
+  algebra.invertDiagonalBlocks(s, deviceA, b, inverses, failure);
+  s.end();
+  s.run();
+  std::vector<double> values(inverses.count());
+  inverses.download(values);
+  std::uint32_t failed = 0;
+  failure.download({&failed, 1});
+  return {values, failed};
+}
+
+TEST_F(VulkanLinearAlgebra, DiagonalBlockInversesMatchEigenForEveryBlockSize) {
+  const Index n = 1200;
+  const compute::SparseMatrix R = randomSparse(n, n, 5, 21);
+  compute::SparseMatrix I(n, n);
+  I.setIdentity();
+  const compute::SparseMatrix A = compute::SparseMatrix(R.transpose() * R) + 0.1 * I;  // SPD, coupled blocks
+  for (std::uint32_t b = 1; b <= 4; ++b) {
+    SCOPED_TRACE(b);
+    const auto [inverses, failed] = invertBlocksOnDevice(context(), algebra(), A, b);
+    EXPECT_EQ(failed, ~0u);
+    double worst = 0.0;
+    for (Index first = 0; first < n; first += b) {
+      const Eigen::MatrixXd block = Eigen::MatrixXd(A).block(first, first, b, b);
+      const Eigen::MatrixXd expected = block.llt().solve(Eigen::MatrixXd::Identity(b, b));
+      Eigen::MatrixXd actual(b, b);
+      for (std::uint32_t i = 0; i < b; ++i) {
+        for (std::uint32_t j = 0; j < b; ++j) actual(i, j) = inverses[first * b + i * b + j];
+      }
+      worst = std::max(worst, (actual - expected).norm() / expected.norm());
+    }
+    EXPECT_LT(worst, 1e-12);
+  }
+}
+
+TEST_F(VulkanLinearAlgebra, DiagonalBlocksThatAreNotPositiveDefiniteAreReportedByTheFirstIndex) {
+  const Index n = 400;
+  compute::SparseMatrix I(n, n);
+  I.setIdentity();
+  compute::SparseMatrix A = compute::SparseMatrix(randomSparse(n, n, 3, 5).transpose() * randomSparse(n, n, 3, 5)) + I;
+  A.coeffRef(4 * 30 + 2, 4 * 30 + 2) = -1.0;                         // block 30 (of 4 rows) indefinite
+  A.coeffRef(4 * 12 + 1, 4 * 12 + 1) = std::numeric_limits<double>::quiet_NaN();  // block 12 not finite
+  const auto [inverses, failed] = invertBlocksOnDevice(context(), algebra(), A, 4);
+  EXPECT_EQ(failed, 12u);
+  EXPECT_EQ(inverses[4 * 30 * 4 + 5], 0.0) << "a failed block is zeros, not garbage";
+  EXPECT_TRUE(std::isfinite(inverses[0]));
 }
 
 TEST_F(VulkanLinearAlgebra, AxpbyScaleRowsAndCopyMatchEigen) {

@@ -99,8 +99,12 @@ TEST_F(MapPrescriptionTest, UnitScalingIsTheIdentityAndInterpolatedScalingsStayP
     const PolygonMesh m = family.mesh(t);
     EXPECT_LT(planarityStats(m).max, 1e-8) << "t = " << t;
     const double change = test::maxAbsDifference(m.vertices, grid.vertices);
-    if (t != 0.0) EXPECT_GT(change, 0.0) << "t = " << t;
-    if (t == 0.5) EXPECT_LT(change, previous) << "deflation shrinks with t -> 1";
+    if (t != 0.0) {
+      EXPECT_GT(change, 0.0) << "t = " << t;
+    }
+    if (t == 0.5) {
+      EXPECT_LT(change, previous) << "deflation shrinks with t -> 1";
+    }
     previous = change;
   }
   // The interpolated maps equal a direct projection of diag(t, t, t, 1).

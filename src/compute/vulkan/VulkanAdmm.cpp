@@ -35,7 +35,7 @@ struct SingleWorkgroupPush {
   double sigma, alpha, tolerance2;
 };
 struct AssemblePush {
-  std::uint32_t nonZeros, pad;
+  std::uint32_t nonZeros, rows;
   double rho;
 };
 
@@ -74,35 +74,6 @@ std::uint32_t blockSize(int block, std::uint32_t n) {
                " unknowns (need 1 to 4 rows dividing the unknowns)");
   }
   return static_cast<std::uint32_t>(block);
-}
-
-/// The block-Jacobi preconditioner of K = K0 + rho K1: the inverses of K's b x b diagonal
-/// blocks, row-major. O(n b^2) on the host per rho update; a block that is not positive
-/// definite gets the error of the SPD solvers (K itself cannot be).
-std::vector<double> inverseDiagonalBlocks(const compute::SparseMatrix& K0, const compute::SparseMatrix& K1, double rho,
-                                          std::uint32_t b) {
-  const auto n = static_cast<std::uint32_t>(K0.rows());
-  std::vector<double> inverses(static_cast<std::size_t>(n) * b);
-  Eigen::Matrix4d block;
-  for (std::uint32_t first = 0; first < n; first += b) {
-    block.setZero();
-    for (std::uint32_t r = first; r < first + b; ++r) {
-      for (int e = K0.outerIndexPtr()[r]; e < K0.outerIndexPtr()[r + 1]; ++e) {
-        const auto c = static_cast<std::uint32_t>(K0.innerIndexPtr()[e]);
-        if (c >= first && c < first + b) block(r - first, c - first) = K0.valuePtr()[e] + rho * K1.valuePtr()[e];
-      }
-    }
-    const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(b, b));
-    if (llt.info() != Eigen::Success || !block.topLeftCorner(b, b).allFinite()) {
-      throwNumerical("ADMM: the diagonal block of rows " + std::to_string(first) + " to " +
-                     std::to_string(first + b - 1) + " of K is not positive definite (nor then is K)");
-    }
-    const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(b, b));
-    for (std::uint32_t i = 0; i < b; ++i) {
-      for (std::uint32_t j = 0; j < b; ++j) inverses[(first + i) * b + j] = inverse(i, j);
-    }
-  }
-  return inverses;
 }
 
 /// P + sigma I with explicit zeros wherever C^T C has an entry: the union pattern, so that
@@ -195,6 +166,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       inverseBlocks_(context, static_cast<std::size_t>(n_) * block_, MemoryClass::Device,
                      "ADMM preconditioner blocks"),
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
+      rowScales_(context, m_, MemoryClass::Device, "ADMM rho scale per row"),
+      blockFailure_(context, 1, MemoryClass::Host, "ADMM preconditioner status"),
       recording_(recording),
       unitsPerDispatch_(unitsPerDispatch),
       spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
@@ -205,7 +178,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       rhs_(context, "admm_rhs", 4, sizeof(RhsPush)),
       update_(context, "admm_update", 7, sizeof(UpdatePush)),
       support_(context, "admm_support", 4, sizeof(SupportPush)),
-      assemble_(context, "admm_assemble", 3, sizeof(AssemblePush)),
+      assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
       singleWorkgroup_(context, "admm_single_workgroup", kSingleWorkgroupBuffers, sizeof(SingleWorkgroupPush),
                        singleWorkgroupSize(context)),
       assembly_(context),
@@ -219,30 +192,42 @@ AdmmKernels::~AdmmKernels() = default;
 
 void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   if (equality.size() != m_) throwUsage("ADMM: equality flags for " + std::to_string(equality.size()) + " rows");
-  if (K1_.size() == 0 || equality != equality_) {
+  // A new equality pattern (at most once per solve) changes K1 = C^T D C: built here and
+  // uploaded. A rho update alone moves no mesh-sized data: K, the per-row penalties and
+  // the preconditioner's blocks are recomputed on the device; one flag comes back.
+  if (!k1Uploaded_ || equality != equality_) {
     Eigen::VectorXd D(m_);
     for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
     const compute::SparseMatrix CtDC = Ct_ * D.asDiagonal() * C_;
-    K1_ = CtDC + K0_ * 0.0;  // onto the union pattern
-    K1_.makeCompressed();
-    if (K1_.nonZeros() != K0_.nonZeros() ||
-        !std::equal(K0_.innerIndexPtr(), K0_.innerIndexPtr() + K0_.nonZeros(), K1_.innerIndexPtr()) ||
-        !std::equal(K0_.outerIndexPtr(), K0_.outerIndexPtr() + n_ + 1, K1_.outerIndexPtr())) {
+    compute::SparseMatrix K1 = CtDC + K0_ * 0.0;  // onto the union pattern
+    K1.makeCompressed();
+    if (K1.nonZeros() != K0_.nonZeros() ||
+        !std::equal(K0_.innerIndexPtr(), K0_.innerIndexPtr() + K0_.nonZeros(), K1.innerIndexPtr()) ||
+        !std::equal(K0_.outerIndexPtr(), K0_.outerIndexPtr() + n_ + 1, K1.outerIndexPtr())) {
       throwDevice("Vulkan ADMM: K0 and K1 do not share one sparsity pattern");
     }
-    k1Values_.upload({K1_.valuePtr(), static_cast<std::size_t>(K1_.nonZeros())});
+    k1Values_.upload({K1.valuePtr(), static_cast<std::size_t>(K1.nonZeros())});
+    rowScales_.upload({D.data(), static_cast<std::size_t>(D.size())});
     equality_ = equality;
+    k1Uploaded_ = true;
   }
-  inverseBlocks_.upload(inverseDiagonalBlocks(K0_, K1_, rho, block_));
-  std::vector<double> rows(m_);
-  for (std::uint32_t i = 0; i < m_; ++i) rows[i] = equality[i] ? rho * settings_.equalityRhoScale : rho;
-  rhoRows_.upload(rows);
+  const std::uint32_t noFailure = ~0u;
+  blockFailure_.upload({&noFailure, 1});
   const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
   assembly_.begin();
-  assembly_.dispatch(assemble_, {k0Values_, k1Values_, devK_.values()}, AssemblePush{nonZeros, 0, rho},
-                     groupsFor(context_, nonZeros));
+  assembly_.dispatch(assemble_, {k0Values_, k1Values_, devK_.values(), rowScales_, rhoRows_},
+                     AssemblePush{nonZeros, m_, rho}, groupsFor(context_, std::max(nonZeros, m_)));
+  assembly_.barrier();
+  algebra_.invertDiagonalBlocks(assembly_, devK_, block_, inverseBlocks_, blockFailure_);
   assembly_.end();
   assembly_.run();
+  std::uint32_t failure = noFailure;
+  blockFailure_.download({&failure, 1});
+  if (failure != noFailure) {
+    const std::uint64_t first = static_cast<std::uint64_t>(failure) * block_;
+    throwNumerical("ADMM: the diagonal block of rows " + std::to_string(first) + " to " +
+                   std::to_string(first + block_ - 1) + " of K is not positive definite (nor then is K)");
+  }
   longFirstSolve_ = true;
 }
 

@@ -99,8 +99,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   compute::SparseMatrix C_;
   compute::SparseMatrix Ct_;
   compute::SparseMatrix K0_;         ///< P + sigma I on the union pattern (host copy).
-  compute::SparseMatrix K1_;         ///< C^T D C on the union pattern (host copy).
-  std::vector<char> equality_;       ///< Rows of K1_'s D = equalityRhoScale.
+  std::vector<char> equality_;       ///< Rows of K1's D = equalityRhoScale.
+  bool k1Uploaded_ = false;          ///< k1Values_ and rowScales_ hold equality_'s K1 and D.
   LinearAlgebra algebra_;
   DeviceCsrMatrix devP_;
   DeviceCsrMatrix devC_;
@@ -111,6 +111,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   std::uint32_t block_;               ///< Preconditioner block size (AdmmSettings::preconditionerBlock).
   Array<double> inverseBlocks_;      ///< n / block_ inverse diagonal blocks of K, row-major.
   Array<double> rhoRows_;            ///< rho per constraint row.
+  Array<double> rowScales_;          ///< D per constraint row: rhoRows_ = rho D.
+  Array<std::uint32_t> blockFailure_;  ///< First block of K that is not positive definite, or ~0.
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_;

@@ -24,6 +24,9 @@ struct AxpbyPush {
 struct ScalePush {
   std::uint32_t n, m, b;
 };
+struct BlockInversePush {
+  std::uint32_t blocks, b;
+};
 struct MaxAbsPush {
   std::uint32_t n, terms;
   double b, c;
@@ -117,7 +120,8 @@ LinearAlgebra::LinearAlgebra(Context& context)
       scaleRows_(context, "la_scale_rows", 3, sizeof(ScalePush)),
       clamp_(context, "la_clamp", 4, sizeof(CountPush)),
       maxAbs_(context, "la_max_abs", 4, sizeof(MaxAbsPush)),
-      reduceMax_(context, "la_reduce_max", 2, sizeof(ReducePush)) {}
+      reduceMax_(context, "la_reduce_max", 2, sizeof(ReducePush)),
+      blockInverse_(context, "block_jacobi_inverse", 5, sizeof(BlockInversePush)) {}
 
 void LinearAlgebra::spmv(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceVectors& X, DeviceVectors& Y) {
   if (X.n() != A.cols() || Y.n() != A.rows() || X.m() != Y.m()) {
@@ -195,6 +199,20 @@ void LinearAlgebra::applyBlockDiagonal(Sequence& sequence, const Array<double>& 
   }
   sequence.dispatch(scaleRows_, {blocks, X.data(), Y.data()}, ScalePush{X.n(), X.m(), b},
                     groupsFor(context_, static_cast<std::size_t>(X.n()) * X.m()));
+  sequence.barrier();
+}
+
+void LinearAlgebra::invertDiagonalBlocks(Sequence& sequence, const DeviceCsrMatrix& A, std::uint32_t b,
+                                         Array<double>& inverses, Array<std::uint32_t>& failure) {
+  if (b < 1 || b > 4 || A.rows() != A.cols() || A.rows() % b != 0 ||
+      inverses.count() != static_cast<std::size_t>(A.rows()) * b || failure.count() < 1) {
+    throwUsage("invertDiagonalBlocks: " + std::to_string(A.rows()) + "x" + std::to_string(A.cols()) +
+               " matrix, blocks of " + std::to_string(b) + ", " + std::to_string(inverses.count()) +
+               " block entries (need a square matrix, 1 to 4 rows per block dividing its rows, rows x b entries)");
+  }
+  const std::uint32_t blocks = A.rows() / b;
+  sequence.dispatch(blockInverse_, {A.rowOffsets(), A.columns(), A.values(), inverses, failure},
+                    BlockInversePush{blocks, b}, groupsFor(context_, blocks));
   sequence.barrier();
 }
 

@@ -114,6 +114,13 @@ class LinearAlgebra {
   /// acting on rows b i .. b i + b - 1 of every column (b = 1: scaleRows).
   void applyBlockDiagonal(Sequence& sequence, const Array<double>& blocks, std::uint32_t b, const DeviceVectors& X,
                           DeviceVectors& Y);
+  /// `inverses` = the inverses of A's b x b diagonal blocks (b = 1 to 4; block j is rows
+  /// and columns b j .. b j + b - 1), row-major as applyBlockDiagonal reads them: the
+  /// block-Jacobi preconditioner, computed from each block's Cholesky factor where A is.
+  /// A block that is not positive definite or not finite gets zeros and leaves its index
+  /// in failure[0], which must hold ~0u when the sequence runs (the smallest index wins).
+  void invertDiagonalBlocks(Sequence& sequence, const DeviceCsrMatrix& A, std::uint32_t b, Array<double>& inverses,
+                            Array<std::uint32_t>& failure);
   /// Y = min(max(X, L), U) entry by entry.
   void clamp(Sequence& sequence, const DeviceVectors& X, const DeviceVectors& L, const DeviceVectors& U,
              DeviceVectors& Y);
@@ -135,6 +142,7 @@ class LinearAlgebra {
   Pipeline clamp_;
   Pipeline maxAbs_;
   Pipeline reduceMax_;
+  Pipeline blockInverse_;
 };
 
 }  // namespace plano::vk
