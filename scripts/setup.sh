@@ -11,6 +11,10 @@ PACKAGES=(
   libeigen3-dev libopenmesh-dev libglm-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libspectra-dev libsuitesparse-dev libcli11-dev nlohmann-json3-dev
+  # CHOLMOD and SPQR run their dense fronts through BLAS/LAPACK: OpenBLAS instead of the
+  # reference implementation makes the sparse factorizations 1.4-2.4x faster (README).
+  # The serial build, so that it never competes with Plano's own threads.
+  libopenblas0-serial
 )
 
 missing=()
