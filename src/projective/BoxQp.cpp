@@ -63,6 +63,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   info.status = toBoxQpStatus(admm.status);
   info.iterations = admm.iterations;
   info.factorizations = admm.factorizations;
+  info.linearIterations = admm.linearIterations;
   info.primalResidual = admm.primalResidual;
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;

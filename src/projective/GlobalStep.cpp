@@ -173,6 +173,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
+    info.linearIterations += qpInfo.linearIterations;
     rho_ = qpInfo.rho;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
       throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");

@@ -71,6 +71,7 @@ struct GlobalStepInfo {
   double positionalResidual = 0.0;   ///< max |C_s A - d| over positional rows.
   int admmIterations = 0;            ///< Summed over the attempts.
   int factorizations = 0;
+  long linearIterations = 0;         ///< Of the ADMM's solves with K, summed (BoxQpInfo).
   bool polished = false;
   Index nonPositiveScales = 0;       ///< Corners with shat <= 0 (reported, not an error).
   std::vector<EpsilonAttempt> attempts;

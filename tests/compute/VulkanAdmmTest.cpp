@@ -467,6 +467,10 @@ TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
   EXPECT_EQ(deviceInfo.epsilon, hostInfo.epsilon);
   EXPECT_EQ(deviceInfo.polished, hostInfo.polished);
   EXPECT_GT(hostInfo.admmIterations, 0);
+  // The solves with K: one factored solve per ADMM iteration on the host, PCG iterations
+  // (several per solve) on the device.
+  EXPECT_EQ(hostInfo.linearIterations, hostInfo.admmIterations);
+  EXPECT_GT(deviceInfo.linearIterations, deviceInfo.admmIterations);
   double worst = 0.0;
   for (std::size_t f = 0; f < hostMaps.maps.size(); ++f) {
     worst = std::max(worst, (deviceMaps.maps[f] - hostMaps.maps[f]).cwiseAbs().maxCoeff());

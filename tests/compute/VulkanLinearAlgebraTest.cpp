@@ -43,19 +43,23 @@ class VulkanLinearAlgebra : public VulkanTest {
 };
 
 TEST_F(VulkanLinearAlgebra, SpmvMatchesEigenOnRectangularMatrixAndSeveralColumns) {
+  // One column per workgroup row of the dispatch: 1 to 9 columns.
   const compute::SparseMatrix A = randomSparse(3000, 2000, 7, 1);
-  const Eigen::MatrixXd X = randomBlock(2000, 3, 2);
   vk::DeviceCsrMatrix deviceA(context(), A);
-  vk::DeviceVectors x = vectors(X);
-  vk::DeviceVectors y(context(), 3000, 3, "y");
-  vk::Sequence s(context());
-  s.begin();
-  algebra().spmv(s, deviceA, x, y);
-  s.end();
-  s.run();
-  Eigen::MatrixXd Y;
-  y.download(Y);
-  EXPECT_LT(relativeError(Y, A * X), 1e-12);
+  for (Index columns : {1, 3, 4, 5, 9}) {
+    SCOPED_TRACE(columns);
+    const Eigen::MatrixXd X = randomBlock(2000, columns, 2);
+    vk::DeviceVectors x = vectors(X);
+    vk::DeviceVectors y(context(), 3000, static_cast<std::uint32_t>(columns), "y");
+    vk::Sequence s(context());
+    s.begin();
+    algebra().spmv(s, deviceA, x, y);
+    s.end();
+    s.run();
+    Eigen::MatrixXd Y;
+    y.download(Y);
+    EXPECT_LT(relativeError(Y, A * X), 1e-12);
+  }
 }
 
 TEST_F(VulkanLinearAlgebra, DotProductsMatchEigenPerColumnForManySizes) {

@@ -42,6 +42,22 @@ TEST_F(VulkanPcgSolver, MatchesCholmodToTheRequestedTolerance) {
   EXPECT_LT((X - reference).norm() / reference.norm(), 1e-6);
 }
 
+TEST_F(VulkanPcgSolver, SolvesSixRightHandSidesEachToTheTolerance) {
+  // Each column has its own step lengths and stopping test.
+  const PolygonMesh mesh = generate::translationalSurface(20, 20);
+  const compute::SparseMatrix A = laplacianLikeSpd(mesh, 0.01);
+  Eigen::MatrixXd B(mesh.vertexCount(), 6);
+  B << rightHandSides(mesh), mesh.vertices.array().cos().matrix();
+  compute::LinearSolverSettings settings;
+  settings.relativeTolerance = 1e-10;
+  auto pcg = backend().createSpdSolver(A, settings);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(B.rows(), B.cols());
+  EXPECT_TRUE(pcg->solve(B, X).converged);
+  for (Eigen::Index c = 0; c < B.cols(); ++c) {
+    EXPECT_LE((A * X.col(c) - B.col(c)).norm() / B.col(c).norm(), 1.5e-10) << "column " << c;
+  }
+}
+
 TEST_F(VulkanPcgSolver, WarmStartFromTheSolutionNeedsNoIterations) {
   const PolygonMesh mesh = generate::hexagonalDome(6);
   const compute::SparseMatrix A = laplacianLikeSpd(mesh, 0.1);
