@@ -42,12 +42,40 @@ struct BlockMultigridSettings {
 /// (0 .. pairCount - 1), pairs numbered in order of their first block.
 std::vector<Index> pairBlocks(const SparseMatrix& K, int block, Index& pairCount);
 
+/// The levels' aggregates, chosen once from a matrix's couplings (pairs of pairs per level,
+/// until at most coarsestBlocks blocks remain or coarsening stalls). Every matrix with the
+/// same structure (K = K0 + rho K1 for any rho) can then be coarsened with them.
+class BlockAggregation {
+ public:
+  /// Throws Error(Usage) for a bad block size.
+  BlockAggregation(const SparseMatrix& K, const BlockMultigridSettings& settings = {});
+
+  int levelCount() const { return static_cast<int>(blocks_.size()); }
+  int block() const { return block_; }
+  /// Blocks of level l (level 0: the matrix's).
+  Index blocks(int level) const { return blocks_[level]; }
+  /// Level l's aggregate of each of its blocks (a block of level l + 1), l < levelCount() - 1.
+  const std::vector<Index>& aggregates(int level) const { return aggregates_[level]; }
+  /// Prolongation Z_l from level l + 1 to level l: row b i + k has a 1 in column b a_i + k.
+  SparseMatrix prolongation(int level) const;
+  /// A on every level: A_0 = A, A_{l+1} = Z_l^T A_l Z_l (compressed).
+  std::vector<SparseMatrix> coarsen(const SparseMatrix& A) const;
+
+ private:
+  int block_;
+  std::vector<Index> blocks_;
+  std::vector<std::vector<Index>> aggregates_;
+};
+
+/// The V-cycle over given level matrices (those of BlockAggregation::coarsen).
 class BlockMultigrid {
  public:
-  /// Build the levels of K (symmetric positive definite, size a multiple of `block`).
-  /// Throws Error(Usage) for a bad block size, Error(Numerical) when a diagonal block or
-  /// the coarsest matrix is not positive definite.
-  BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings = {});
+  /// Aggregate K and build its levels. Throws Error(Usage) for a bad block size,
+  /// Error(Numerical) when a diagonal block or the coarsest matrix is not positive definite.
+  explicit BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings = {});
+  /// The cycle of `levels` (one matrix per level of `aggregation`).
+  BlockMultigrid(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels,
+                 double smootherDamping = BlockMultigridSettings{}.smootherDamping);
 
   /// One V-cycle from a zero initial guess: z ~ K^-1 r.
   Eigen::VectorXd apply(const Eigen::VectorXd& r) const;
@@ -64,11 +92,12 @@ class BlockMultigrid {
     std::vector<Eigen::MatrixXd> inverseBlocks;  ///< Damped: omega * K_ii^-1.
     std::vector<Index> aggregate;                ///< Block -> coarse block (empty on the coarsest).
   };
+  void build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels, double smootherDamping);
   Eigen::VectorXd cycle(int level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd smooth(const Level& level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd restrictToCoarse(const Level& level, Index coarseRows, const Eigen::VectorXd& r) const;
 
-  BlockMultigridSettings settings_;
+  int block_ = 1;
   std::vector<Level> levels_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarsest_;
 };

@@ -14,7 +14,7 @@
 // by the inverses of K's diagonal blocks (AdmmSettings::preconditionerBlock rows each; the
 // global step uses one face's four map entries, which K couples strongly: on its QPs a
 // cold-started PCG needs 3.7-9x fewer iterations than with Jacobi, and a whole single-level
-// deformation 2.5x fewer). The host inverts the small blocks at each rho update. The
+// deformation 2.5x fewer). The device inverts the small blocks at each rho update. The
 // iterations are recorded (a cap per ADMM iteration) and sized through
 // indirect dispatches by a one-thread control kernel (shaders/pcg_control.comp): once
 // every column has r.z <= tol^2 b.z and ||r|| below the host's bound from the ADMM
