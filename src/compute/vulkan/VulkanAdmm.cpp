@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/LinearAlgebraPushConstants.h"
 #include "compute/vulkan/PcgPushConstants.h"
 #include "core/Cancellation.h"
 #include "core/Error.h"
@@ -12,9 +13,6 @@ namespace plano::vk {
 namespace {
 
 // Push constants of the ADMM kernels (layouts of the shaders' Push blocks).
-struct ReducePush {
-  std::uint32_t groups, m, slot;
-};
 struct ControlPush {
   std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, pad0, pad1;
   double tolerance2;
@@ -33,10 +31,6 @@ struct SupportPush {
 struct SingleWorkgroupPush {
   std::uint32_t n, m, k, iterations, cap, budget, begin, block;
   double sigma, alpha, tolerance2;
-};
-struct AssemblePush {
-  std::uint32_t nonZeros, rows;
-  double rho;
 };
 
 // PCG scalar slots (k values each). r.r follows its r.z: pcg_step's paired reduction

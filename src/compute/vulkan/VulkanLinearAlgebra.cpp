@@ -3,27 +3,12 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/LinearAlgebraPushConstants.h"
 #include "core/Error.h"
 
 namespace plano::vk {
 namespace {
 
-struct SpmvPush {
-  std::uint32_t rows, cols;
-};
-struct DotPush {
-  std::uint32_t n;
-};
-struct ReducePush {
-  std::uint32_t groups, m, slot;
-};
-struct AxpbyPush {
-  std::uint32_t count, pad;
-  double a, b;
-};
-struct ScalePush {
-  std::uint32_t n, m, b;
-};
 struct BlockInversePush {
   std::uint32_t blocks, b;
 };

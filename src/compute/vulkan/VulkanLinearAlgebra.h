@@ -29,6 +29,8 @@ class DeviceCsrMatrix {
   const Array<std::int32_t>& rowOffsets() const { return rowOffsets_; }
   const Array<std::int32_t>& columns() const { return columns_; }
   const Array<double>& values() const { return values_; }
+  /// For new values on the same pattern (uploaded, or written by a kernel).
+  Array<double>& values() { return values_; }
 
  private:
   std::uint32_t rows_;

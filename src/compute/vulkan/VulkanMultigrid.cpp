@@ -1,0 +1,237 @@
+#include "compute/vulkan/VulkanMultigrid.h"
+
+#include <Eigen/Cholesky>
+#include <string>
+
+#include "compute/vulkan/LinearAlgebraPushConstants.h"
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct TransferPush {  // mg_restrict, mg_prolong
+  std::uint32_t fineRows, coarseRows, m, b;
+};
+
+/// A's pattern with every stored value 1 (no cancellation when coarsened).
+compute::SparseMatrix ones(const compute::SparseMatrix& A) {
+  compute::SparseMatrix pattern = A;
+  for (Eigen::Index e = 0; e < pattern.nonZeros(); ++e) pattern.valuePtr()[e] = 1.0;
+  return pattern;
+}
+
+/// A on `pattern` (explicit zeros where A has no entry); Error(Device) when A has an entry
+/// outside it.
+compute::SparseMatrix onPattern(const compute::SparseMatrix& A, const compute::SparseMatrix& pattern) {
+  compute::SparseMatrix result = A + pattern * 0.0;
+  result.makeCompressed();
+  if (result.nonZeros() != pattern.nonZeros()) throwDevice("Vulkan multigrid: a level matrix leaves its pattern");
+  return result;
+}
+
+std::span<const double> valuesOf(const compute::SparseMatrix& A) {
+  return {A.valuePtr(), static_cast<std::size_t>(A.nonZeros())};
+}
+
+}  // namespace
+
+struct Multigrid::Level {
+  std::uint32_t rows = 0;
+  std::unique_ptr<DeviceCsrMatrix> K;             ///< Levels 1 .. L-2: K_l; the coarsest: K^-1 (dense).
+  std::unique_ptr<Array<double>> k0, k1;          ///< Levels 1 .. L-2: values on K's pattern.
+  std::unique_ptr<Array<double>> inverses;        ///< Levels 1 .. L-2: block-Jacobi inverses.
+  std::unique_ptr<DeviceVectors> r, z;            ///< Levels 1 ..: restricted residual, correction.
+  std::unique_ptr<DeviceVectors> t, u;            ///< Levels 0 .. L-2: residual and smoothing scratch.
+  std::unique_ptr<Array<std::int32_t>> aggregates, childOffsets, children;  ///< Levels 0 .. L-2.
+};
+
+/// Descriptor sets of one level's steps.
+struct LevelSets {
+  std::unique_ptr<DescriptorSet> smoothDown, product, residual, restrictTo, prolongFrom, smoothUp, update;
+};
+
+struct Multigrid::Binding::Sets {
+  std::vector<LevelSets> levels;  ///< Level 0's refer to the bound operands.
+  std::unique_ptr<DescriptorSet> coarsest;
+};
+
+Multigrid::Binding::Binding() : sets_(std::make_unique<Sets>()) {}
+Multigrid::Binding::~Binding() = default;
+
+Multigrid::Multigrid(Context& context, const compute::BlockAggregation& aggregation, const compute::SparseMatrix& K0,
+                     const compute::SparseMatrix& pattern)
+    : context_(context),
+      algebra_(context),
+      block_(static_cast<std::uint32_t>(aggregation.block())),
+      columns_(0),
+      aggregation_(aggregation),
+      spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
+      scale_(context, "la_scale_rows", 3, sizeof(ScalePush)),
+      axpby_(context, "la_axpby", 2, sizeof(AxpbyPush)),
+      restrict_(context, "mg_restrict", 4, sizeof(TransferPush)),
+      prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
+      assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
+      noRows_(context, 1, MemoryClass::Device, "multigrid unused rows") {
+  const int L = aggregation_.levelCount();
+  const std::vector<compute::SparseMatrix> patternLevels = aggregation_.coarsen(ones(pattern));
+  const std::vector<compute::SparseMatrix> k0Levels = aggregation_.coarsen(onPattern(K0, pattern));
+  for (int l = 0; l < L; ++l) {
+    auto level = std::make_unique<Level>();
+    level->rows = elementCount(patternLevels[l].rows(), "a multigrid level's rows");
+    const bool coarsest = l + 1 == L;
+    if (!coarsest) {
+      const std::vector<Index>& aggregate = aggregation_.aggregates(l);
+      std::vector<std::int32_t> parents(aggregate.begin(), aggregate.end());
+      std::vector<std::int32_t> offsets(aggregation_.blocks(l + 1) + 1, 0);
+      for (Index a : aggregate) ++offsets[a + 1];
+      for (std::size_t i = 1; i < offsets.size(); ++i) offsets[i] += offsets[i - 1];
+      std::vector<std::int32_t> children(aggregate.size());
+      std::vector<std::int32_t> next(offsets.begin(), offsets.end() - 1);
+      for (std::size_t i = 0; i < aggregate.size(); ++i) children[next[aggregate[i]]++] = static_cast<std::int32_t>(i);
+      level->aggregates = std::make_unique<Array<std::int32_t>>(context, parents.size(), MemoryClass::Device, "multigrid aggregates");
+      level->aggregates->upload(parents);
+      level->childOffsets = std::make_unique<Array<std::int32_t>>(context, offsets.size(), MemoryClass::Device, "multigrid aggregate offsets");
+      level->childOffsets->upload(offsets);
+      level->children = std::make_unique<Array<std::int32_t>>(context, children.size(), MemoryClass::Device, "multigrid aggregate members");
+      level->children->upload(children);
+    }
+    if (l > 0 && !coarsest) {
+      const compute::SparseMatrix values = onPattern(k0Levels[l], patternLevels[l]);
+      level->K = std::make_unique<DeviceCsrMatrix>(context, values);
+      level->k0 = std::make_unique<Array<double>>(context, values.nonZeros(), MemoryClass::Device, "multigrid K0 values");
+      level->k0->upload(valuesOf(values));
+      level->k1 = std::make_unique<Array<double>>(context, values.nonZeros(), MemoryClass::Device, "multigrid K1 values");
+      level->inverses = std::make_unique<Array<double>>(context, static_cast<std::size_t>(level->rows) * block_,
+                                                        MemoryClass::Device, "multigrid block inverses");
+    }
+    if (coarsest) {
+      const compute::SparseMatrix dense = Eigen::MatrixXd::Ones(level->rows, level->rows).sparseView();
+      compute::SparseMatrix full = dense;
+      full.makeCompressed();
+      level->K = std::make_unique<DeviceCsrMatrix>(context, full);
+      coarsestK0_ = k0Levels[l];
+    }
+    patterns_.push_back(patternLevels[l]);
+    levels_.push_back(std::move(level));
+  }
+}
+
+Multigrid::~Multigrid() = default;
+
+void Multigrid::setK1(const compute::SparseMatrix& K1) {
+  const std::vector<compute::SparseMatrix> k1Levels = aggregation_.coarsen(onPattern(K1, patterns_.front()));
+  for (int l = 1; l + 1 < levelCount(); ++l) levels_[l]->k1->upload(valuesOf(onPattern(k1Levels[l], patterns_[l])));
+  coarsestK1_ = k1Levels.back();
+}
+
+void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure) {
+  if (coarsestK1_.rows() == 0) throwUsage("multigrid: setRho before setK1");
+  for (int l = 1; l + 1 < levelCount(); ++l) {
+    Level& level = *levels_[l];
+    const auto nonZeros = static_cast<std::uint32_t>(level.k0->count());
+    sequence.dispatch(assemble_, {*level.k0, *level.k1, level.K->values(), noRows_, noRows_},
+                      AssemblePush{nonZeros, 0, rho}, groupsFor(context_, nonZeros));
+    sequence.barrier();
+    algebra_.invertDiagonalBlocks(sequence, *level.K, block_, *level.inverses, failure);
+  }
+  // The coarsest level: a dense inverse from its two small matrices.
+  const Eigen::MatrixXd K = Eigen::MatrixXd(coarsestK0_) + rho * Eigen::MatrixXd(coarsestK1_);
+  const Eigen::LLT<Eigen::MatrixXd> llt(K);
+  if (llt.info() != Eigen::Success || !K.allFinite()) {
+    throwNumerical("ADMM: the coarsest multigrid level of K is not positive definite (nor then is K)");
+  }
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse =
+      llt.solve(Eigen::MatrixXd::Identity(K.rows(), K.cols()));
+  levels_.back()->K->values().upload({inverse.data(), static_cast<std::size_t>(inverse.size())});
+}
+
+std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks,
+                                                    const DeviceVectors& r, DeviceVectors& z) {
+  if (r.n() != levels_.front()->rows || z.n() != r.n() || z.m() != r.m()) {
+    throwUsage("multigrid: operands of " + std::to_string(r.n()) + " x " + std::to_string(r.m()) + " and " +
+               std::to_string(z.n()) + " x " + std::to_string(z.m()) + " for " + std::to_string(levels_.front()->rows) +
+               " rows");
+  }
+  const int L = levelCount();
+  if (columns_ != r.m()) {  // (re)size the levels' vectors; bindings made for another count are void
+    columns_ = r.m();
+    for (int l = 0; l < L; ++l) {
+      Level& level = *levels_[l];
+      if (l > 0) {
+        level.r = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid residual");
+        level.z = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid correction");
+      }
+      if (l + 1 < L) {
+        level.t = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid residual scratch");
+        level.u = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid smoothing scratch");
+      }
+    }
+  }
+  std::unique_ptr<Binding> binding(new Binding());
+  for (int l = 0; l + 1 < L; ++l) {
+    Level& level = *levels_[l];
+    Level& coarse = *levels_[l + 1];
+    const DeviceCsrMatrix& matrix = l == 0 ? K : *level.K;
+    const Array<double>& inverses = l == 0 ? inverseBlocks : *level.inverses;
+    const Array<double>& rl = l == 0 ? r.data() : level.r->data();
+    const Array<double>& zl = l == 0 ? z.data() : level.z->data();
+    LevelSets sets;
+    sets.smoothDown = std::make_unique<DescriptorSet>(context_, scale_, std::initializer_list<BufferRange>{inverses, rl, zl});
+    sets.product = std::make_unique<DescriptorSet>(
+        context_, spmv_,
+        std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, level.t->data()});
+    sets.residual = std::make_unique<DescriptorSet>(context_, axpby_, std::initializer_list<BufferRange>{rl, level.t->data()});
+    sets.restrictTo = std::make_unique<DescriptorSet>(
+        context_, restrict_,
+        std::initializer_list<BufferRange>{*level.childOffsets, *level.children, level.t->data(), coarse.r->data()});
+    sets.prolongFrom = std::make_unique<DescriptorSet>(
+        context_, prolong_, std::initializer_list<BufferRange>{*level.aggregates, coarse.z->data(), zl});
+    sets.smoothUp = std::make_unique<DescriptorSet>(
+        context_, scale_, std::initializer_list<BufferRange>{inverses, level.t->data(), level.u->data()});
+    sets.update = std::make_unique<DescriptorSet>(context_, axpby_, std::initializer_list<BufferRange>{level.u->data(), zl});
+    binding->sets_->levels.push_back(std::move(sets));
+  }
+  const Level& last = *levels_.back();
+  const Array<double>& rc = L == 1 ? r.data() : last.r->data();
+  const Array<double>& zc = L == 1 ? z.data() : last.z->data();
+  binding->sets_->coarsest = std::make_unique<DescriptorSet>(
+      context_, spmv_, std::initializer_list<BufferRange>{last.K->rowOffsets(), last.K->columns(), last.K->values(), rc, zc});
+  return binding;
+}
+
+void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t rowsTriple,
+                       std::size_t elementsTriple) {
+  const std::uint32_t k = columns_;
+  if (k == 0) throwUsage("multigrid: record before bind");
+  // Products: one workgroup row per column; the rest: over all entries.
+  auto run = [&](const Pipeline& pipeline, const DescriptorSet& set, const auto& push, bool rows, std::uint32_t count) {
+    if (arguments) {
+      sequence.dispatchIndirect(pipeline, set, push, *arguments, rows ? rowsTriple : elementsTriple);
+    } else {
+      sequence.dispatch(pipeline, set, push, groupsFor(context_, count), rows ? k : 1);
+    }
+    sequence.barrier();
+  };
+  const int L = levelCount();
+  for (int l = 0; l + 1 < L; ++l) {
+    const LevelSets& sets = binding.sets_->levels[l];
+    const std::uint32_t n = levels_[l]->rows, nc = levels_[l + 1]->rows;
+    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, false, n * k);         // z = S r
+    run(spmv_, *sets.product, SpmvPush{n, n}, true, n);                           // t = K z
+    run(axpby_, *sets.residual, AxpbyPush{n * k, 0, 1.0, -1.0}, false, n * k);     // t = r - t
+    run(restrict_, *sets.restrictTo, TransferPush{n, nc, k, block_}, false, nc * k);  // r_c = Z^T t
+  }
+  const std::uint32_t nc = levels_.back()->rows;
+  run(spmv_, *binding.sets_->coarsest, SpmvPush{nc, nc}, true, nc);  // z_c = K_c^-1 r_c
+  for (int l = L - 2; l >= 0; --l) {
+    const LevelSets& sets = binding.sets_->levels[l];
+    const std::uint32_t n = levels_[l]->rows, coarse = levels_[l + 1]->rows;
+    run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, false, n * k);  // z += Z z_c
+    run(spmv_, *sets.product, SpmvPush{n, n}, true, n);                                // t = K z
+    run(axpby_, *sets.residual, AxpbyPush{n * k, 0, 1.0, -1.0}, false, n * k);          // t = r - t
+    run(scale_, *sets.smoothUp, ScalePush{n, k, block_}, false, n * k);                 // u = S t
+    run(axpby_, *sets.update, AxpbyPush{n * k, 0, 1.0, 1.0}, false, n * k);             // z = u + z
+  }
+}
+
+}  // namespace plano::vk

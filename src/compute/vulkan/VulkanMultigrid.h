@@ -1,0 +1,84 @@
+#pragma once
+// The aggregation V-cycle of compute/BlockMultigrid.h on the device, as the preconditioner
+// of the ADMM's inner PCG with K = K0 + rho K1.
+//
+// The levels' aggregates are fixed when the solver is built; the coarse matrices are
+// Galerkin products, and since coarsening is linear, K_l = K0_l + rho K1_l with K0_l and
+// K1_l coarsened once on the host (K0 per solver, K1 when the equality pattern changes,
+// like the ADMM's own K1). A rho update is then device work only: K_l on every level
+// (admm_assemble) and the block-Jacobi inverses of every level but the coarsest
+// (block_jacobi_inverse); the coarsest level (at most BlockMultigridSettings::coarsestBlocks
+// blocks) is inverted densely on the host from its two small matrices and uploaded, a
+// transfer that does not grow with the mesh.
+//
+// One cycle: on each level, z = S r (block-Jacobi), t = r - K z, restrict t; the coarsest
+// z = K^-1 r; back up, z += Z z_coarse, t = r - K z, z += S t. Every dispatch is sized by
+// one of two caller-given indirect triples, so that inside a recorded PCG the cycles of a
+// converged solve cost empty dispatches: a rows triple (x workgroups, one workgroup row per
+// column) for the products and an elements triple (x workgroups, 1) for the rest; all
+// kernels loop grid-stride, so any x count is correct.
+#include <memory>
+#include <vector>
+
+#include "compute/BlockMultigrid.h"
+#include "compute/vulkan/VulkanLinearAlgebra.h"
+
+namespace plano::vk {
+
+class Multigrid {
+ public:
+  /// The levels of `aggregation` for K0 (level 0 on the caller's pattern `pattern`, which
+  /// must also hold K1's entries).
+  Multigrid(Context& context, const compute::BlockAggregation& aggregation, const compute::SparseMatrix& K0,
+            const compute::SparseMatrix& pattern);
+  ~Multigrid();
+  Multigrid(const Multigrid&) = delete;
+  Multigrid& operator=(const Multigrid&) = delete;
+
+  /// K1 on level 0's pattern: coarsen and upload it (a new equality pattern).
+  void setK1(const compute::SparseMatrix& K1);
+  /// Record K_l = K0_l + rho K1_l on the coarse levels and the block inverses of levels
+  /// 1 .. L-2 into `sequence` (level 0's are the caller's); upload the coarsest inverse.
+  /// A coarse block that is not positive definite leaves its index in `failure`.
+  void setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure);
+
+  /// The cycle's level-0 operands: input r, output z, K and its block inverses. Descriptor
+  /// sets are built once per binding; a recording refers to it. The levels' vectors are
+  /// sized for r's columns: a binding for another count voids the earlier bindings.
+  class Binding {
+   public:
+    ~Binding();
+    Binding(const Binding&) = delete;
+    Binding& operator=(const Binding&) = delete;
+
+   private:
+    friend class Multigrid;
+    Binding();
+    struct Sets;
+    std::unique_ptr<Sets> sets_;
+  };
+  std::unique_ptr<Binding> bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks, const DeviceVectors& r,
+                                DeviceVectors& z);
+  /// Record one cycle z = M r of `binding`, each dispatch indirect from `arguments` (the
+  /// rows and elements triples' byte offsets), or direct when `arguments` is null.
+  void record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t rowsTriple,
+              std::size_t elementsTriple);
+
+  int levelCount() const { return static_cast<int>(levels_.size()); }
+
+ private:
+  struct Level;
+
+  Context& context_;
+  LinearAlgebra algebra_;
+  std::uint32_t block_;
+  std::uint32_t columns_;
+  compute::BlockAggregation aggregation_;
+  std::vector<compute::SparseMatrix> patterns_;  ///< Level patterns (values 0), levels 1 ..
+  std::vector<std::unique_ptr<Level>> levels_;   ///< Levels 0 .. L-1 (level 0 holds only temporaries).
+  compute::SparseMatrix coarsestK0_, coarsestK1_;
+  Pipeline spmv_, scale_, axpby_, restrict_, prolong_, assemble_;
+  Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
+};
+
+}  // namespace plano::vk
