@@ -9,6 +9,7 @@
 
 #include "MemoryCounters.h"
 #include "VulkanBenchSupport.h"
+#include "compute/Admm.h"
 #include "compute/Backend.h"
 #include "mesh/Generators.h"
 #include "projective/Deformation.h"
@@ -57,7 +58,8 @@ void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
 
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:
 /// a global step that needs real ADMM work.
-void BM_GlobalStep(benchmark::State& state, BackendChoice choice) {
+void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
+                   plano::compute::AdmmPreconditioner preconditioner = plano::compute::AdmmPreconditioner::Automatic) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   const plano::bench::MemoryCounters memory(state, backend);
@@ -73,6 +75,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice) {
   for (Index f = 0; f < space.faceCount(); f += 2) targets[f].topLeftCorner<3, 3>() = R;
   plano::projective::GlobalStepSettings settings;
   settings.epsilonStart = plano::projective::EpsilonStart::ExactFirst;
+  settings.qp.preconditioner = preconditioner;
   plano::projective::GlobalStep global(*backend, space, fixed, settings);
   plano::projective::FaceMaps result;
   plano::projective::GlobalStepInfo info;
@@ -120,6 +123,9 @@ BENCHMARK_CAPTURE(BM_LocalStep, vulkan, BackendChoice::Vulkan)->Arg(4096)->Arg(6
 // hundreds of iterations per solve on these equality-row QPs).
 BENCHMARK_CAPTURE(BM_GlobalStep, cpu, BackendChoice::Cpu)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
+                  plano::compute::AdmmPreconditioner::BlockJacobi)
+    ->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan, BackendChoice::Vulkan)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DeformationIteration, cpu, BackendChoice::Cpu)

@@ -21,6 +21,18 @@
 
 namespace plano::compute {
 
+/// The iterative backends' preconditioner of K in the inner solves.
+enum class AdmmPreconditioner {
+  BlockJacobi,  ///< Inverses of K's diagonal blocks of preconditionerBlock rows.
+  /// An aggregation V-cycle over those blocks (compute/BlockMultigrid.h): several times
+  /// fewer PCG iterations on the global step's stiff matrices, each iteration dearer.
+  Multigrid,
+  /// Multigrid when K has more blocks than the cycle's coarsest level
+  /// (BlockMultigridSettings::coarsestBlocks), where the cycle has coarse levels at all;
+  /// block-Jacobi on smaller problems, whose many cheap iterations cost less.
+  Automatic,
+};
+
 struct AdmmSettings {
   double rho = 0.1;                      ///< Initial penalty of inequality rows.
   double equalityRhoScale = 1e3;         ///< rho of rows with l = u, relative to rho.
@@ -48,6 +60,7 @@ struct AdmmSettings {
   /// Unknowns that K couples strongly in small groups (a face's map entries) converge in
   /// several times fewer PCG iterations with their group as a block.
   int preconditionerBlock = 1;
+  AdmmPreconditioner preconditioner = AdmmPreconditioner::BlockJacobi;
 };
 
 enum class AdmmStatus {

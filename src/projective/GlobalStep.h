@@ -46,7 +46,15 @@ struct GlobalStepSettings {
   double initialEpsilonFraction = 1e-2;
   double epsilonGrowth = 10.0;
   int maxEpsilonIncreases = 8;
-  BoxQpSettings qp;
+  /// The QP's settings. On an iterative backend the inner solves with K of more than 64
+  /// faces use the aggregation multigrid over faces (compute/BlockMultigrid.h): several
+  /// times fewer PCG iterations than face blocks, and the host's ADMM iteration kept where
+  /// those drift.
+  BoxQpSettings qp = [] {
+    BoxQpSettings s;
+    s.preconditioner = compute::AdmmPreconditioner::Automatic;
+    return s;
+  }();
 };
 
 /// One eps of the schedule.

@@ -371,6 +371,7 @@ TEST_F(VulkanAdmm, GlobalStepQpGivesTheHostIterates) {
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
   settings.linearSolver.relativeTolerance = 1e-12;
+  settings.preconditioner = compute::AdmmPreconditioner::BlockJacobi;  // both recordings
   const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
   ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
   EXPECT_GT(host.info.iterations, settings.checkInterval);
@@ -390,7 +391,8 @@ TEST_F(VulkanAdmm, EqualityRowsKeepTheHostIterationWithTheDefaultInnerTolerance)
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
   compute::CpuBackend cpu;
-  const compute::AdmmSettings settings = recorder.settingsUsed;
+  compute::AdmmSettings settings = recorder.settingsUsed;
+  settings.preconditioner = compute::AdmmPreconditioner::BlockJacobi;  // the single-workgroup recording
   ASSERT_EQ(settings.linearSolver.relativeTolerance, compute::LinearSolverSettings{}.relativeTolerance);
   ASSERT_TRUE((recorder.qp.lower.array() == recorder.qp.upper.array()).all()) << "every row an equality";
   const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
@@ -405,12 +407,64 @@ TEST_F(VulkanAdmm, EqualityRowsKeepTheHostIterationWithTheDefaultInnerTolerance)
   EXPECT_GT(drifting.info.iterations, host.info.iterations) << "the bound made no difference on this QP";
 }
 
+TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgIterations) {
+  // 144 faces (two multigrid levels), the exact (eps = 0) attempt's QP: every row an
+  // equality row, the default inner tolerance, the multi-dispatch recording. Measured: host
+  // 30 ADMM iterations; face blocks 40 ADMM with 5 438 PCG iterations (near convergence the
+  // inner solves' absolute bound, 1 % of the ADMM residuals, is hard to reach on
+  // right-hand sides scaled by rho * 10^3, capped solves make inexact steps and the rho
+  // balance drifts); multigrid 30 ADMM with 2 604. The gap grows with the mesh: on 576
+  // faces (three levels) 80 ADMM / 27 336 PCG against 50 / 5 246, host 30.
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings = recorder.settingsUsed;
+  const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
+  ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
+  const Recording& multiDispatch = kRecordings[0];
+  settings.preconditioner = compute::AdmmPreconditioner::BlockJacobi;
+  const AdmmRun blocks = runAdmm(context(), recorder.qp, settings, multiDispatch);
+  settings.preconditioner = compute::AdmmPreconditioner::Multigrid;
+  const AdmmRun multigrid = runAdmm(context(), recorder.qp, settings, multiDispatch);
+  SCOPED_TRACE("face blocks: " + std::to_string(blocks.info.iterations) + " ADMM, " +
+               std::to_string(blocks.info.linearIterations) + " PCG iterations; multigrid: " +
+               std::to_string(multigrid.info.iterations) + " ADMM, " + std::to_string(multigrid.info.linearIterations) +
+               " PCG; host " + std::to_string(host.info.iterations) + " ADMM");
+  expectAgreement(multigrid, host, settings, 1e-6);
+  EXPECT_EQ(multigrid.info.iterations, host.info.iterations);
+  EXPECT_LT(multigrid.info.linearIterations, blocks.info.linearIterations);
+  EXPECT_GE(blocks.info.iterations, multigrid.info.iterations);
+}
+
+TEST_F(VulkanAdmm, AutomaticPreconditionerIsMultigridAboveTheCoarsestLevelOnly) {
+  for (Index side : {8, 12}) {  // 64 faces: one level, no coarsening; 144: two levels
+    RecordingBackend recorder;
+    ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(side, recorder));
+    const compute::AdmmSettings settings = recorder.settingsUsed;
+    ASSERT_EQ(settings.preconditioner, compute::AdmmPreconditioner::Automatic);
+    const vk::AdmmKernels automatic(context(), recorder.qp.P, recorder.qp.C, settings);
+    EXPECT_EQ(automatic.multigrid(), side == 12) << side * side << " faces";
+    const vk::AdmmKernels single(context(), recorder.qp.P, recorder.qp.C, settings, vk::AdmmRecording::SingleWorkgroup);
+    EXPECT_FALSE(single.multigrid()) << "the single-workgroup kernel has no cycle";
+  }
+}
+
+TEST_F(VulkanAdmm, MultigridRefusesTheSingleWorkgroupRecording) {
+  const BoxQp qp = randomBoxQp(32, 12, 5);
+  compute::AdmmSettings settings;
+  settings.preconditionerBlock = 4;
+  settings.preconditioner = compute::AdmmPreconditioner::Multigrid;
+  EXPECT_THROW(vk::AdmmKernels(context(), qp.P, qp.C, settings, vk::AdmmRecording::SingleWorkgroup), Error);
+}
+
 TEST_F(VulkanAdmm, FaceBlocksPreconditionGlobalStepQpsBetterThanJacobi) {
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
   ASSERT_EQ(settings.preconditionerBlock, 4) << "the global step preconditions by faces";
+  EXPECT_EQ(settings.preconditioner, compute::AdmmPreconditioner::Automatic) << "multigrid over faces when large";
+  settings.preconditioner = compute::AdmmPreconditioner::BlockJacobi;
   settings.linearSolver.relativeTolerance = 1e-12;
   const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
   long iterations[2];

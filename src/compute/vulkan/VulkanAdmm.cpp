@@ -132,6 +132,9 @@ struct AdmmKernels::Workspace {
   Array<std::uint32_t> arguments;
   // The inner PCG's descriptor sets, built once: a block records thousands of dispatches.
   std::unique_ptr<DescriptorSet> spmvDotSet, reduceSet, stepSet, directionSet, controlSet, singleWorkgroupSet;
+  // With the multigrid preconditioner: its cycles z = M r and M rhs (for b.z), and r.z's partial sums.
+  std::unique_ptr<Multigrid::Binding> cycleResidual, cycleRhs;
+  std::unique_ptr<DescriptorSet> rzSet;
   Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
   Sequence check;  ///< The inf-norms of AdmmMeasures.
   /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
@@ -162,6 +165,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
       rowScales_(context, m_, MemoryClass::Device, "ADMM rho scale per row"),
       blockFailure_(context, 1, MemoryClass::Host, "ADMM preconditioner status"),
+      coarseFailure_(context, 1, MemoryClass::Host, "ADMM multigrid status"),
       recording_(recording),
       unitsPerDispatch_(unitsPerDispatch),
       spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
@@ -175,11 +179,29 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
       singleWorkgroup_(context, "admm_single_workgroup", kSingleWorkgroupBuffers, sizeof(SingleWorkgroupPush),
                        singleWorkgroupSize(context)),
+      dot_(context, "la_dot", 3, sizeof(DotPush)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
   Ct_.makeCompressed();
   k0Values_.upload({K0_.valuePtr(), static_cast<std::size_t>(K0_.nonZeros())});
+  const compute::BlockMultigridSettings multigridSettings{static_cast<int>(block_)};
+  const bool multigrid =
+      settings_.preconditioner == compute::AdmmPreconditioner::Multigrid ||
+      (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
+       recording_ != AdmmRecording::SingleWorkgroup &&
+       static_cast<Index>(n_ / block_) > multigridSettings.coarsestBlocks);
+  if (settings_.preconditioner == compute::AdmmPreconditioner::Multigrid &&
+      recording_ == AdmmRecording::SingleWorkgroup) {
+    throwUsage("ADMM: the multigrid preconditioner runs only in the multi-dispatch recording");
+  }
+  if (multigrid) {
+    // Aggregates from K at rho = 1 with every row an inequality row: the couplings'
+    // pattern and rough sizes, which is all the pairing needs; they stay for every rho.
+    const compute::SparseMatrix CtC = Ct_ * C_;
+    aggregation_ = std::make_unique<compute::BlockAggregation>(compute::SparseMatrix(K0_ + CtC), multigridSettings);
+    multigrid_ = std::make_unique<Multigrid>(context_, *aggregation_, K0_, K0_);
+  }
 }
 
 AdmmKernels::~AdmmKernels() = default;
@@ -201,6 +223,7 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
       throwDevice("Vulkan ADMM: K0 and K1 do not share one sparsity pattern");
     }
     k1Values_.upload({K1.valuePtr(), static_cast<std::size_t>(K1.nonZeros())});
+    if (multigrid_) multigrid_->setK1(K1);
     rowScales_.upload({D.data(), static_cast<std::size_t>(D.size())});
     equality_ = equality;
     k1Uploaded_ = true;
@@ -213,6 +236,10 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
                      AssemblePush{nonZeros, m_, rho}, groupsFor(context_, std::max(nonZeros, m_)));
   assembly_.barrier();
   algebra_.invertDiagonalBlocks(assembly_, devK_, block_, inverseBlocks_, blockFailure_);
+  if (multigrid_) {
+    coarseFailure_.upload({&noFailure, 1});
+    multigrid_->setRho(assembly_, rho, coarseFailure_);
+  }
   assembly_.end();
   assembly_.run();
   std::uint32_t failure = noFailure;
@@ -221,6 +248,12 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
     const std::uint64_t first = static_cast<std::uint64_t>(failure) * block_;
     throwNumerical("ADMM: the diagonal block of rows " + std::to_string(first) + " to " +
                    std::to_string(first + block_ - 1) + " of K is not positive definite (nor then is K)");
+  }
+  if (multigrid_) {
+    coarseFailure_.download({&failure, 1});
+    if (failure != noFailure) {
+      throwNumerical("ADMM: a diagonal block of a coarse multigrid level of K is not positive definite (nor then is K)");
+    }
   }
   longFirstSolve_ = true;
 }
@@ -260,6 +293,7 @@ bool AdmmKernels::useSingleWorkgroup(std::uint32_t k) const {
   const bool fits = k <= kSingleWorkgroupColumns &&
                     context_.info().maxStorageBuffersPerStage >= kSingleWorkgroupBuffers &&
                     singleWorkgroupBudget(k) > 0;
+  if (multigrid_) return false;  // the cycle is recorded only in the multi-dispatch PCG
   switch (recording_) {
     case AdmmRecording::MultiDispatch: return false;
     case AdmmRecording::Automatic: return fits && n_ <= kSingleWorkgroupUnknowns;
@@ -302,6 +336,12 @@ void AdmmKernels::prepare(std::uint32_t k) {
       context_, direction_, std::initializer_list<BufferRange>{w.preconditioned.data(), w.p.data(), w.pcg.values()});
   w.controlSet = std::make_unique<DescriptorSet>(
       context_, control_, std::initializer_list<BufferRange>{w.pcg.values(), w.state, w.arguments});
+  if (multigrid_) {
+    w.cycleResidual = multigrid_->bind(devK_, inverseBlocks_, w.r, w.preconditioned);
+    w.cycleRhs = multigrid_->bind(devK_, inverseBlocks_, w.rhs, w.Kp);
+    w.rzSet = std::make_unique<DescriptorSet>(
+        context_, dot_, std::initializer_list<BufferRange>{w.r.data(), w.preconditioned.data(), w.pcg.partial()});
+  }
   if (w.singleWorkgroup) {
     w.singleWorkgroupSet = std::make_unique<DescriptorSet>(
         context_, singleWorkgroup_,
@@ -365,11 +405,19 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
   la.spmv(s, devK_, w.xTilde, w.Kp);
   la.copy(s, w.rhs, w.r);
   la.axpby(s, -1.0, w.Kp, 1.0, w.r);
-  la.applyBlockDiagonal(s, inverseBlocks_, block_, w.r, w.preconditioned);
+  if (multigrid_) {
+    multigrid_->record(s, *w.cycleResidual, nullptr, 0, 0);
+  } else {
+    la.applyBlockDiagonal(s, inverseBlocks_, block_, w.r, w.preconditioned);
+  }
   la.copy(s, w.preconditioned, w.p);
   la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
   la.dot(s, w.r, w.r, w.pcg, kRrEven);
-  la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);  // Kp as scratch for M^-1 b
+  if (multigrid_) {  // Kp as scratch for M^-1 b
+    multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
+  } else {
+    la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
+  }
   la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
 
   const std::uint32_t groups = w.pcg.groups();
@@ -392,6 +440,13 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
     s.dispatchIndirect(step_, *w.stepSet, PcgStepPush{n_, k, current, kPq, block_, 1}, w.arguments,
                        kFusedArguments);
     s.barrier();
+    if (multigrid_) {
+      // The step's z = blockdiag^-1 r and its r.z are replaced: z = M r, then r.z's partial
+      // sums (r.r's, from the step, stay), all sized by the control's triples.
+      multigrid_->record(s, *w.cycleResidual, &w.arguments, kFusedArguments, kDirectionArguments);
+      s.dispatchIndirect(dot_, *w.rzSet, DotPush{n_}, w.arguments, kFusedArguments);
+      s.barrier();
+    }
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, next}, w.arguments, kPairReduceArguments);
     s.barrier();
     s.dispatchIndirect(direction_, *w.directionSet, PcgDirectionPush{n_, k, next, current}, w.arguments,

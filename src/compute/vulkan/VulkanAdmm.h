@@ -39,7 +39,9 @@
 #include <memory>
 
 #include "compute/Admm.h"
+#include "compute/BlockMultigrid.h"
 #include "compute/vulkan/VulkanLinearAlgebra.h"
+#include "compute/vulkan/VulkanMultigrid.h"
 
 namespace plano::vk {
 
@@ -80,6 +82,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   void setLinearTolerance(double tolerance) override;
   /// Whether the current workspace (after start()) records one dispatch per block.
   bool singleWorkgroup() const;
+  /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
+  bool multigrid() const { return multigrid_ != nullptr; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
 
  private:
@@ -113,9 +117,12 @@ class AdmmKernels final : public compute::AdmmKernels {
   Array<double> rhoRows_;            ///< rho per constraint row.
   Array<double> rowScales_;          ///< D per constraint row: rhoRows_ = rho D.
   Array<std::uint32_t> blockFailure_;  ///< First block of K that is not positive definite, or ~0.
+  std::unique_ptr<compute::BlockAggregation> aggregation_;  ///< AdmmPreconditioner::Multigrid only.
+  std::unique_ptr<Multigrid> multigrid_;
+  Array<std::uint32_t> coarseFailure_;  ///< A coarse level's block that is not positive definite, or ~0.
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
-  Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_;
+  Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
