@@ -8,8 +8,8 @@
 // grows with rho and with the mesh (README, "The GPU target"). A coarse space of maps that
 // are constant over small groups of faces is close to that near-null space: as the PCG
 // preconditioner, a V-cycle over such groups needs 9-15x fewer iterations on 1k-4k-face
-// global-step matrices, and the cut grows with the mesh (BlockMultigridTest). Not yet used
-// by the device PCG, which still runs face-block Jacobi.
+// global-step matrices, and the cut grows with the mesh (BlockMultigridTest). The device's
+// cycle (vk::Multigrid) preconditions the global step's ADMM above 64 faces.
 //
 // Construction (plain aggregation AMG, block version): the unknowns come in blocks of b
 // rows (a face's map entries); each level pairs every block with its most strongly coupled

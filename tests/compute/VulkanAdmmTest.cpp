@@ -449,6 +449,28 @@ TEST_F(VulkanAdmm, AutomaticPreconditionerIsMultigridAboveTheCoarsestLevelOnly) 
   }
 }
 
+TEST_F(VulkanAdmm, UncoupledBlocksFallBackToFaceBlocksOrAreRefusedForAnExplicitMultigrid) {
+  // K block-diagonal (each constraint row within one block): no block pairs, so the
+  // coarsening stalls at all 300 blocks, too many for the dense coarsest inverse.
+  const Index blocks = 300;
+  compute::SparseMatrix P(4 * blocks, 4 * blocks), C(blocks, 4 * blocks);
+  P.setIdentity();
+  for (Index b = 0; b < blocks; ++b) C.insert(b, 4 * b) = 1.0;
+  C.makeCompressed();
+  compute::AdmmSettings settings;
+  settings.preconditionerBlock = 4;
+  settings.preconditioner = compute::AdmmPreconditioner::Automatic;
+  EXPECT_FALSE(vk::AdmmKernels(context(), P, C, settings).multigrid());
+  settings.preconditioner = compute::AdmmPreconditioner::Multigrid;
+  try {
+    vk::AdmmKernels kernels(context(), P, C, settings);
+    ADD_FAILURE() << "a stalled coarsening was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+    EXPECT_NE(std::string(e.what()).find("stopped at 300 blocks"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(VulkanAdmm, MultigridRefusesTheSingleWorkgroupRecording) {
   const BoxQp qp = randomBoxQp(32, 12, 5);
   compute::AdmmSettings settings;

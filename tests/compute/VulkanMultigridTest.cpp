@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
 
 #include "compute/GlobalStepMatrices.h"
 #include "compute/VulkanFixture.h"
@@ -21,6 +22,18 @@ Eigen::MatrixXd randomColumns(Index n, Index m, unsigned seed) {
   std::mt19937 random(seed);
   std::normal_distribution<double> normal;
   return Eigen::MatrixXd::NullaryExpr(n, m, [&](Eigen::Index, Eigen::Index) { return normal(random); });
+}
+
+/// K0 = P + sigma I and K1 = C^T C on their union pattern, as the device ADMM keeps them.
+std::pair<compute::SparseMatrix, compute::SparseMatrix> splitK(const GlobalStepMatrices& qp) {
+  compute::SparseMatrix I(qp.P.rows(), qp.P.rows());
+  I.setIdentity();
+  const compute::SparseMatrix CtC = qp.C.transpose() * qp.C;
+  compute::SparseMatrix K0 = qp.P + I * qp.sigma + CtC * 0.0;
+  K0.makeCompressed();
+  compute::SparseMatrix K1 = CtC + K0 * 0.0;
+  K1.makeCompressed();
+  return {K0, K1};
 }
 
 /// The device cycle z = M r for K = K0 + rho K1 (K0 = P + sigma I and K1 = C^T C on their
@@ -59,14 +72,7 @@ Eigen::MatrixXd deviceCycle(vk::Context& context, const compute::BlockAggregatio
 }
 
 TEST_F(VulkanMultigrid, CycleEqualsTheHostReferenceOnAGlobalStepMatrix) {
-  const GlobalStepMatrices qp = globalStepMatrices(24);  // 576 faces: three levels
-  compute::SparseMatrix I(qp.P.rows(), qp.P.rows());
-  I.setIdentity();
-  const compute::SparseMatrix CtC = qp.C.transpose() * qp.C;
-  compute::SparseMatrix K0 = qp.P + I * qp.sigma + CtC * 0.0;  // the union pattern
-  K0.makeCompressed();
-  compute::SparseMatrix K1 = CtC + K0 * 0.0;
-  K1.makeCompressed();
+  const auto [K0, K1] = splitK(globalStepMatrices(24));  // 576 faces: three levels
   const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), {4});
   ASSERT_GE(aggregation.levelCount(), 3);
   const Eigen::MatrixXd r = randomColumns(K0.rows(), 3, 7);
@@ -86,14 +92,7 @@ TEST_F(VulkanMultigrid, CycleEqualsTheHostReferenceOnAGlobalStepMatrix) {
 }
 
 TEST_F(VulkanMultigrid, OneLevelIsTheExactInverse) {
-  const GlobalStepMatrices qp = globalStepMatrices(4);  // 16 faces: below the coarsest size
-  compute::SparseMatrix I(qp.P.rows(), qp.P.rows());
-  I.setIdentity();
-  const compute::SparseMatrix CtC = qp.C.transpose() * qp.C;
-  compute::SparseMatrix K0 = qp.P + I * qp.sigma + CtC * 0.0;
-  K0.makeCompressed();
-  compute::SparseMatrix K1 = CtC + K0 * 0.0;
-  K1.makeCompressed();
+  const auto [K0, K1] = splitK(globalStepMatrices(4));  // 16 faces: below the coarsest size
   const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), {4});
   ASSERT_EQ(aggregation.levelCount(), 1);
   const Eigen::MatrixXd r = randomColumns(K0.rows(), 2, 8);

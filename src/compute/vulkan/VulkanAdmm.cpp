@@ -200,7 +200,19 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // pattern and rough sizes, which is all the pairing needs; they stay for every rho.
     const compute::SparseMatrix CtC = Ct_ * C_;
     aggregation_ = std::make_unique<compute::BlockAggregation>(compute::SparseMatrix(K0_ + CtC), multigridSettings);
-    multigrid_ = std::make_unique<Multigrid>(context_, *aggregation_, K0_, K0_);
+    // Coarsening stalls where K couples few blocks (say, faces without shared vertices);
+    // the coarsest level is then too large for its dense inverse.
+    const Index coarsest = aggregation_->blocks(aggregation_->levelCount() - 1);
+    if (coarsest > kMaxCoarsestBlocks) {
+      if (settings_.preconditioner == compute::AdmmPreconditioner::Multigrid) {
+        throwUsage("ADMM: the multigrid's coarsening stopped at " + std::to_string(coarsest) +
+                   " blocks (K couples too few of them), more than the " + std::to_string(kMaxCoarsestBlocks) +
+                   " its coarsest level may have; use the block-Jacobi preconditioner");
+      }
+      aggregation_.reset();  // Automatic: face blocks
+    } else {
+      multigrid_ = std::make_unique<Multigrid>(context_, *aggregation_, K0_, K0_);
+    }
   }
 }
 

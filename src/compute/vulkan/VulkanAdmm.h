@@ -14,7 +14,10 @@
 // by the inverses of K's diagonal blocks (AdmmSettings::preconditionerBlock rows each; the
 // global step uses one face's four map entries, which K couples strongly: on its QPs a
 // cold-started PCG needs 3.7-9x fewer iterations than with Jacobi, and a whole single-level
-// deformation 2.5x fewer). The device inverts the small blocks at each rho update. The
+// deformation 2.5x fewer), or by the aggregation multigrid V-cycle over those blocks
+// (AdmmSettings::preconditioner, vk::Multigrid: each PCG iteration runs one cycle after the
+// step, recorded and sized like the rest of the iteration). The device inverts the small
+// blocks at each rho update. The
 // iterations are recorded (a cap per ADMM iteration) and sized through
 // indirect dispatches by a one-thread control kernel (shaders/pcg_control.comp): once
 // every column has r.z <= tol^2 b.z and ||r|| below the host's bound from the ADMM
@@ -65,6 +68,10 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Columns and storage buffers of the single-workgroup kernel.
   static constexpr std::uint32_t kSingleWorkgroupColumns = 4;
   static constexpr std::uint32_t kSingleWorkgroupBuffers = 24;
+  /// Largest coarsest multigrid level (blocks) the cycle inverts densely (4 x its target of
+  /// 64: coarsening that stalls above this falls back to, or with an explicit choice
+  /// refuses for, block-Jacobi).
+  static constexpr Index kMaxCoarsestBlocks = 256;
 
   /// Upload P (n x n), C (m x n) and C^T. Throws Error(Device) when a buffer exceeds the device.
   /// `unitsPerDispatch` > 0 overrides the single-workgroup kernel's work per dispatch
