@@ -28,8 +28,10 @@ enum class AdmmPreconditioner {
   /// fewer PCG iterations on the global step's stiff matrices, each iteration dearer.
   Multigrid,
   /// Multigrid when K has more blocks than the cycle's coarsest level
-  /// (BlockMultigridSettings::coarsestBlocks), where the cycle has coarse levels at all;
-  /// block-Jacobi on smaller problems, whose many cheap iterations cost less.
+  /// (BlockMultigridSettings::coarsestBlocks), where the cycle has coarse levels at all,
+  /// and its coarsening does not stall on a large coarsest level; block-Jacobi otherwise
+  /// (small problems, whose many cheap iterations cost less) and in a single-workgroup
+  /// recording.
   Automatic,
 };
 

@@ -57,8 +57,12 @@ TEST_F(PrescribeInterpolateCommands, InterpolateReturnsTheEndpointsAndPlanarMesh
                                  " -o " + path("i.obj") + " --report " + path("i.json"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const PolygonMesh out = readMesh(dir / "i.obj");
-    if (t == 0.0) EXPECT_LT(test::maxAbsDifference(out.vertices, mesh.vertices), 1e-6);
-    if (t == 1.0) EXPECT_LT(test::maxAbsDifference(out.vertices, b.vertices), 1e-6);
+    if (t == 0.0) {
+      EXPECT_LT(test::maxAbsDifference(out.vertices, mesh.vertices), 1e-6);
+    }
+    if (t == 1.0) {
+      EXPECT_LT(test::maxAbsDifference(out.vertices, b.vertices), 1e-6);
+    }
     EXPECT_LT(report("i.json")["planarity"]["max"].get<double>(), 1e-3) << "t = " << t;
   }
   EXPECT_EQ(test::runTool("interpolate " + path("grid.obj") + " missing.obj --t 0.5 -o " + path("i.obj")).exitCode, 3);
