@@ -41,13 +41,13 @@ std::pair<compute::SparseMatrix, compute::SparseMatrix> splitK(const GlobalStepM
 Eigen::MatrixXd deviceCycle(vk::Context& context, const compute::BlockAggregation& aggregation,
                             const compute::SparseMatrix& K0, const compute::SparseMatrix& K1, double rho,
                             const Eigen::MatrixXd& r, int* levels = nullptr) {
-  vk::Multigrid multigrid(context, aggregation, K0, K0);
+  vk::LinearAlgebra algebra(context);
+  vk::Multigrid multigrid(context, algebra, aggregation, K0, K0);
   multigrid.setK1(K1);
   if (levels) *levels = multigrid.levelCount();
   compute::SparseMatrix K = K0 + K1 * rho;
   K.makeCompressed();
   vk::DeviceCsrMatrix deviceK(context, K);
-  vk::LinearAlgebra algebra(context);
   vk::Array<double> inverses(context, static_cast<std::size_t>(K.rows()) * 4, vk::MemoryClass::Device, "inverses");
   vk::Array<std::uint32_t> failure(context, 1, vk::MemoryClass::Host, "failure");
   const std::uint32_t none = ~0u;

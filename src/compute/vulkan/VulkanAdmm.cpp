@@ -211,7 +211,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       }
       aggregation_.reset();  // Automatic: face blocks
     } else {
-      multigrid_ = std::make_unique<Multigrid>(context_, *aggregation_, K0_, K0_);
+      multigrid_ = std::make_unique<Multigrid>(context_, algebra_, *aggregation_, K0_, K0_);
     }
   }
 }

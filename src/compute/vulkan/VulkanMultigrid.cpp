@@ -58,10 +58,10 @@ struct Multigrid::Binding::Sets {
 Multigrid::Binding::Binding() : sets_(std::make_unique<Sets>()) {}
 Multigrid::Binding::~Binding() = default;
 
-Multigrid::Multigrid(Context& context, const compute::BlockAggregation& aggregation, const compute::SparseMatrix& K0,
-                     const compute::SparseMatrix& pattern)
+Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::BlockAggregation& aggregation,
+                     const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern)
     : context_(context),
-      algebra_(context),
+      algebra_(algebra),
       block_(static_cast<std::uint32_t>(aggregation.block())),
       columns_(0),
       aggregation_(aggregation),

@@ -28,9 +28,10 @@ namespace plano::vk {
 class Multigrid {
  public:
   /// The levels of `aggregation` for K0 (level 0 on the caller's pattern `pattern`, which
-  /// must also hold K1's entries).
-  Multigrid(Context& context, const compute::BlockAggregation& aggregation, const compute::SparseMatrix& K0,
-            const compute::SparseMatrix& pattern);
+  /// must also hold K1's entries). `algebra` (the caller's, kept by reference) inverts the
+  /// coarse levels' blocks.
+  Multigrid(Context& context, LinearAlgebra& algebra, const compute::BlockAggregation& aggregation,
+            const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern);
   ~Multigrid();
   Multigrid(const Multigrid&) = delete;
   Multigrid& operator=(const Multigrid&) = delete;
@@ -70,7 +71,7 @@ class Multigrid {
   struct Level;
 
   Context& context_;
-  LinearAlgebra algebra_;
+  LinearAlgebra& algebra_;
   std::uint32_t block_;
   std::uint32_t columns_;
   compute::BlockAggregation aggregation_;
