@@ -130,6 +130,10 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
                        const AdmmSettings& settings)
     : kernels_(std::move(kernels)), n_(n), m_(m), settings_(settings), rho_(settings.rho) {
   if (settings_.checkInterval < 1) throwUsage("ADMM: checkInterval must be at least 1");
+  if (settings_.stallIterations < 0) throwUsage("ADMM: stallIterations must be >= 0 (0: never stop as stalled)");
+  if (!(settings_.stallChange >= 0.0 && settings_.stallChange < 1.0)) {
+    throwUsage("ADMM: stallChange must be in [0, 1)");
+  }
   if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
     throwUsage("ADMM: linearToleranceFraction must be a finite number > 0");
   }
@@ -196,6 +200,30 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     return false;
   };
 
+  // The stall window (AdmmSettings::stallIterations): where it began and the range of
+  // ||dy|| seen in it; restarted after a rho change.
+  struct StallWindow {
+    int begin = -1;
+    double primal = 0.0;
+    double dyMin = 0.0, dyMax = 0.0;
+  } window;
+  auto stalled = [&]() {
+    if (settings_.stallIterations <= 0) return false;
+    const double dy = maxOf(s.dy);
+    if (window.begin < 0) {
+      window = {info.iterations, info.primalResidual, dy, dy};
+      return false;
+    }
+    window.dyMin = std::min(window.dyMin, dy);
+    window.dyMax = std::max(window.dyMax, dy);
+    if (info.iterations - window.begin < settings_.stallIterations) return false;
+    const double change = settings_.stallChange;
+    const bool stuck = window.dyMin > 0.0 && window.dyMax <= (1.0 + change) * window.dyMin &&
+                       info.primalResidual >= (1.0 - change) * window.primal;
+    window = {info.iterations, info.primalResidual, dy, dy};
+    return stuck;
+  };
+
   s = kernels_->measure();
   if (converged()) {
     info.status = AdmmStatus::Solved;
@@ -222,10 +250,15 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
         info.status = AdmmStatus::PrimalInfeasible;
         break;
       }
+      if (stalled()) {
+        info.status = AdmmStatus::Stalled;
+        break;
+      }
       if (settings_.adaptiveRho) {
         const double proposed = std::clamp(rho_ * rhoBalance, 1e-6, 1e6);
         if (proposed > rho_ * settings_.adaptiveRhoFactor || proposed < rho_ / settings_.adaptiveRhoFactor) {
           rho_ = proposed;
+          window.begin = -1;
           kernels_->setRho(equality, rho_);
           factoredRho_ = rho_;
           ++info.factorizations;

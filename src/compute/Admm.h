@@ -45,6 +45,15 @@ struct AdmmSettings {
   double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
   int maxIterations = 4000;
   int checkInterval = 10;                ///< Residuals and certificates every this many iterations.
+  /// Stop as Stalled when, through this many iterations (0: never), the dual step
+  /// ||y_k - y_k-1||_inf stayed constant to `stallChange` (relative) and the primal residual
+  /// fell by less than that: y grows linearly, the mark of a problem infeasible, or
+  /// feasible only by a margin below the tolerances, where OSQP's iteration can neither
+  /// converge (that needs dy -> 0) nor certify. Such attempts of the global step's ε
+  /// schedule, which moves on from an unconverged attempt either way, ran into the
+  /// iteration cap. The window restarts whenever rho changes.
+  int stallIterations = 200;
+  double stallChange = 0.01;
   bool adaptiveRho = true;
   double adaptiveRhoFactor = 5.0;        ///< Change K only when rho moves by more than this factor.
   /// Iterative backends stop each inner solve with K when ||r||_2 <= relativeTolerance
@@ -70,6 +79,7 @@ enum class AdmmStatus {
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
+  Stalled,              ///< Primal residual stuck above its tolerance, y diverging (AdmmSettings::stallIterations).
 };
 
 struct AdmmInfo {

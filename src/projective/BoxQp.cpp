@@ -16,6 +16,7 @@ BoxQpStatus toBoxQpStatus(compute::AdmmStatus status) {
     case compute::AdmmStatus::PrimalInfeasible: return BoxQpStatus::PrimalInfeasible;
     case compute::AdmmStatus::MaxIterationsReached: return BoxQpStatus::MaxIterationsReached;
     case compute::AdmmStatus::NonFinite: return BoxQpStatus::NonFinite;
+    case compute::AdmmStatus::Stalled: return BoxQpStatus::Stalled;
   }
   return BoxQpStatus::MaxIterationsReached;
 }
@@ -41,6 +42,7 @@ const char* toString(BoxQpStatus status) {
     case BoxQpStatus::PrimalInfeasible: return "primal_infeasible";
     case BoxQpStatus::MaxIterationsReached: return "max_iterations";
     case BoxQpStatus::NonFinite: return "non_finite";
+    case BoxQpStatus::Stalled: return "stalled";
   }
   return "unknown";
 }

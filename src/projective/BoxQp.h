@@ -34,6 +34,7 @@ enum class BoxQpStatus {
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
+  Stalled,              ///< Neither converging nor certifying (compute::AdmmStatus::Stalled).
 };
 
 const char* toString(BoxQpStatus status);

@@ -224,6 +224,43 @@ TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
   }
 }
 
+TEST_F(VulkanAdmm, AnUncertifiedInfeasibleProblemStopsAsStalledOnBothBackends) {
+  // Rows 0 and 1 both measure x_0 + x_1 but ask for [0, 1] and [2, 3], and the certificate
+  // is switched off (tolerance 0): as where an infeasibility is too slight for it (the
+  // global step's tiny-ε attempts), y only drifts, and without the stall rule the
+  // iteration runs to the cap.
+  BoxQp qp = randomBoxQp(30, 12, 5);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Index i = 0; i < 12; ++i) {
+    entries.emplace_back(i, i < 2 ? 0 : i, 1.0);
+    entries.emplace_back(i, i < 2 ? 1 : i + 1, 1.0);
+  }
+  qp.C.resize(12, 30);
+  qp.C.setFromTriplets(entries.begin(), entries.end());
+  qp.C.makeCompressed();
+  qp.lower.setConstant(-1.0);
+  qp.upper.setConstant(1.0);
+  qp.lower.row(0).setConstant(0.0);
+  qp.upper.row(0).setConstant(1.0);
+  qp.lower.row(1).setConstant(2.0);
+  qp.upper.row(1).setConstant(3.0);
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings;
+  settings.infeasibilityTolerance = 0.0;
+  compute::AdmmSettings untilTheCap = settings;
+  untilTheCap.stallIterations = 0;
+  EXPECT_EQ(runAdmm(cpu, qp, untilTheCap).info.status, compute::AdmmStatus::MaxIterationsReached);
+  const AdmmRun host = runAdmm(cpu, qp, settings);
+  EXPECT_EQ(host.info.status, compute::AdmmStatus::Stalled);
+  EXPECT_LE(host.info.iterations, settings.maxIterations / 4);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun device = runAdmm(context(), qp, settings, recording);
+    EXPECT_EQ(device.info.status, compute::AdmmStatus::Stalled);
+    EXPECT_LE(std::abs(device.info.iterations - host.info.iterations), settings.stallIterations);
+  }
+}
+
 TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
   BoxQp qp = randomBoxQp(40, 30, 3);
   qp.q(7, 1) = std::numeric_limits<double>::quiet_NaN();
