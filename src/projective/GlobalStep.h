@@ -23,8 +23,10 @@
 //
 // The ε schedule is the paper's (§5): eps_0 = 1e-2 max|C_s T - d|, multiplied by 10
 // until the relaxed problem is feasible, where feasible means: the ADMM (BoxQp.h)
-// converged to its primal and dual tolerances. A proven-infeasible or unconverged attempt
-// moves on to the next eps; after `maxEpsilonIncreases` increases, Error(Numerical).
+// converged to its primal and dual tolerances. A proven-infeasible, stalled or unconverged
+// attempt moves on to the next eps; after `maxEpsilonIncreases` increases, Error(Numerical).
+// Attempts whose eps is below what the ADMM's tolerances resolve stall (y drifts without a
+// certificate) and stop after a few hundred iterations (AdmmSettings::stallIterations).
 #include <Eigen/Core>
 #include <string>
 #include <vector>
