@@ -3,6 +3,7 @@
 // direct deformation at the Yas Island scale of the paper's Table 1.
 #include <benchmark/benchmark.h>
 
+#include "VulkanBenchSupport.h"
 #include "compute/Backend.h"
 #include "mesh/Generators.h"
 #include "projective/Deformation.h"
@@ -13,6 +14,7 @@
 
 namespace {
 
+using plano::compute::BackendChoice;
 using plano::projective::SubdivisionScheme;
 
 /// A 32 x 32 translational surface refined `levels` times: 4^levels * 1024 faces.
@@ -48,9 +50,12 @@ namespace {
 
 /// PQ subdivision of a 32 x 32 translational surface (already a conjugate net: one
 /// iteration per level, measuring the pipeline) and of the cube (Catmull-Clark targets far
-/// from planar: the paper's Fig. 2 case, 6 * 4^levels faces).
-void BM_PqSubdivision(benchmark::State& state, bool cube) {
-  auto backend = plano::compute::createBackend(plano::compute::BackendChoice::Cpu);
+/// from planar: the paper's Fig. 2 case, 6 * 4^levels faces), per backend. On lavapipe
+/// only the cube's first level is run (24 faces, two local/global iterations; the second
+/// level alone takes minutes there).
+void BM_PqSubdivision(benchmark::State& state, bool cube, BackendChoice choice) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
   const plano::PolygonMesh base = cube ? plano::generate::cube() : plano::generate::translationalSurface(32, 32);
   plano::projective::PqSubdivisionSettings settings;
   settings.levels = static_cast<int>(state.range(0));
@@ -60,13 +65,22 @@ void BM_PqSubdivision(benchmark::State& state, bool cube) {
     info = result.info;
     benchmark::DoNotOptimize(result.positions.back().data());
   }
+  int admm = 0;
+  for (const auto& level : info.levels) {
+    for (const auto& iteration : level.iterations) admm += iteration.admmIterations;
+  }
   state.counters["faces"] = static_cast<double>(info.levels.back().faces);
   state.counters["iterations"] = info.totalIterations;
+  state.counters["admm_iterations"] = admm;
   state.counters["max_planarity_pct"] = info.levels.back().planarity.max;
 }
 
-BENCHMARK_CAPTURE(BM_PqSubdivision, translational, false)->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_PqSubdivision, cube, true)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_PqSubdivision, translational, false, BackendChoice::Cpu)
+    ->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_PqSubdivision, cube, true, BackendChoice::Cpu)
+    ->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_PqSubdivision, cube_vulkan, true, BackendChoice::Vulkan)
+    ->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // ---- multi-resolution vs direct deformation (paper §6, Table 1) -------------------
 
