@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <random>
 
 #include "MemoryCounters.h"
 #include "VulkanBenchSupport.h"
@@ -117,6 +118,68 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
   state.counters["admm_iterations"] = admm;
 }
 
+/// The global step's constraint matrix on a grid (one row per pair of a vertex's first and
+/// another corner, as GlobalStep builds it) with reciprocal scale factors drawn in
+/// [0.8, 1.2]: the values one local step gives.
+plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeSpace& space, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> scale(0.8, 1.2);
+  std::vector<double> shat(space.cornerCount());
+  for (double& value : shat) value = scale(random);
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::Index row = 0;
+  const auto& offsets = space.vertexCornerOffsets();
+  const auto& corners = space.cornersOfVertex();
+  for (Index v = 0; v < space.vertexCount(); ++v) {
+    const Eigen::RowVector4d p = plano::projective::homogeneous(space.basePositions().row(v));
+    for (Index k = offsets[v] + 1; k < offsets[v + 1]; ++k, ++row) {
+      const Index a = corners[offsets[v]], b = corners[k];
+      for (int j = 0; j < 4; ++j) {
+        entries.emplace_back(row, 4 * space.cornerFace(a) + j, p[j] / shat[a]);
+        entries.emplace_back(row, 4 * space.cornerFace(b) + j, -p[j] / shat[b]);
+      }
+    }
+  }
+  plano::compute::SparseMatrix C(row, 4 * space.faceCount());
+  C.setFromTriplets(entries.begin(), entries.end());
+  return C;
+}
+
+/// What a projective global step pays before its first ADMM iteration, with a new ADMM
+/// solver per step (`new_solver`: buffers, pipelines, K's pattern, the multigrid's
+/// aggregates and coarse patterns) or with the solver kept from the previous step and
+/// given C's new values (`kept_solver`, what GlobalStep does). Both then form K on the
+/// first solve (rho update) and load the problem; the ADMM iterations are excluded (cap 0).
+void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, bool keep) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  const plano::PolygonMesh mesh = grid(state);
+  const plano::projective::ShapeSpace space(mesh);
+  const plano::compute::SparseMatrix C[2] = {compatibilityMatrix(space, 1), compatibilityMatrix(space, 2)};
+  plano::compute::SparseMatrix P(C[0].cols(), C[0].cols());
+  P.setIdentity();
+  plano::compute::AdmmSettings settings;
+  settings.preconditionerBlock = 4;
+  settings.preconditioner = plano::compute::AdmmPreconditioner::Automatic;
+  settings.maxIterations = 0;
+  const Eigen::MatrixXd q = Eigen::MatrixXd::Ones(P.rows(), 3);
+  const Eigen::MatrixXd bounds = Eigen::MatrixXd::Zero(C[0].rows(), 3);
+  std::unique_ptr<plano::compute::AdmmSolver> solver = backend->createAdmmSolver(P, C[0], settings);
+  int step = 0;
+  for (auto _ : state) {
+    const plano::compute::SparseMatrix& values = C[++step % 2];
+    if (keep) {
+      solver->setConstraintValues(values);
+    } else {
+      solver = backend->createAdmmSolver(P, values, settings);
+    }
+    Eigen::MatrixXd x, y, z;
+    solver->solve(q, bounds, bounds, x, y, z);
+    benchmark::DoNotOptimize(x.data());
+  }
+  setCounters(state, mesh);
+}
+
 BENCHMARK_CAPTURE(BM_LocalStep, cpu, BackendChoice::Cpu)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LocalStep, vulkan, BackendChoice::Vulkan)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 // On lavapipe the device global step finishes up to about 1k faces (101 s with the multigrid
@@ -128,6 +191,14 @@ BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
     ->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan, BackendChoice::Vulkan)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_new_solver, BackendChoice::Cpu, false)
+    ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_kept_solver, BackendChoice::Cpu, true)
+    ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_new_solver, BackendChoice::Vulkan, false)
+    ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, true)
+    ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DeformationIteration, cpu, BackendChoice::Cpu)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan, BackendChoice::Vulkan)

@@ -33,7 +33,9 @@ bool allFinite(const Eigen::VectorXd& v) { return v.allFinite(); }
 class HostAdmmKernels final : public AdmmKernels {
  public:
   HostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C, const AdmmSettings& settings)
-      : backend_(backend), settings_(settings), P_(P), C_(C), Ct_(C.transpose()) {}
+      : backend_(backend), settings_(settings), P_(P), C_(C), Ct_(C.transpose()) {
+    C_.makeCompressed();
+  }
 
   void setRho(const std::vector<char>& equality, double rho) override {
     rho_.resize(static_cast<Eigen::Index>(equality.size()));
@@ -41,7 +43,19 @@ class HostAdmmKernels final : public AdmmKernels {
     SparseMatrix I(P_.rows(), P_.rows());
     I.setIdentity();
     const SparseMatrix K = P_ + I * settings_.sigma + SparseMatrix(Ct_ * rho_.asDiagonal() * C_);
-    solver_ = backend_.createSpdSolver(K, settings_.linearSolver);
+    // K's pattern is the same for every rho and every C on one pattern: a factorization
+    // keeps its ordering and symbolic analysis.
+    if (!solver_ || !solver_->refactor(K)) solver_ = backend_.createSpdSolver(K, settings_.linearSolver);
+  }
+
+  void setConstraintValues(const SparseMatrix& C) override {
+    SparseMatrix compressed = C;
+    compressed.makeCompressed();
+    if (!sameSparsityPattern(compressed, C_)) {
+      throwUsage("ADMM: new constraint values on a different sparsity pattern");
+    }
+    C_ = std::move(compressed);
+    Ct_ = C_.transpose();
   }
 
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -116,6 +130,15 @@ class HostAdmmKernels final : public AdmmKernels {
 
 }  // namespace
 
+bool sameSparsityPattern(const SparseMatrix& A, const SparseMatrix& B) {
+  if (!A.isCompressed() || !B.isCompressed() || A.rows() != B.rows() || A.cols() != B.cols() ||
+      A.nonZeros() != B.nonZeros()) {
+    return false;
+  }
+  return std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
+         std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
+}
+
 std::unique_ptr<AdmmKernels> createHostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C,
                                                    const AdmmSettings& settings) {
   return std::make_unique<HostAdmmKernels>(backend, P, C, settings);
@@ -137,6 +160,15 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
   if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
     throwUsage("ADMM: linearToleranceFraction must be a finite number > 0");
   }
+}
+
+void AdmmSolver::setConstraintValues(const SparseMatrix& C) {
+  if (C.rows() != m_ || C.cols() != n_) {
+    throwUsage("ADMM: new constraint values of " + std::to_string(C.rows()) + "x" + std::to_string(C.cols()) +
+               " for a " + std::to_string(m_) + "x" + std::to_string(n_) + " C");
+  }
+  kernels_->setConstraintValues(C);
+  factored_ = false;
 }
 
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,

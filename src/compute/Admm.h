@@ -114,6 +114,10 @@ class AdmmKernels {
   virtual ~AdmmKernels() = default;
   /// Set K = P + sigma I + C^T diag(r) C with r_i = rho * (equality[i] ? scale : 1).
   virtual void setRho(const std::vector<char>& equality, double rho) = 0;
+  /// Replace C by a matrix with the same sparsity pattern (checked by AdmmSolver); K
+  /// changes at the next setRho. What depends on the pattern only (buffers, pipelines, K's
+  /// pattern, a factorization's analysis, a multigrid's aggregates) is kept.
+  virtual void setConstraintValues(const SparseMatrix& C) = 0;
   /// Load q (n x k), bounds (m x k) and warm starts; z = clamp(C x, l, u), xTilde = x.
   virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                      const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
@@ -145,6 +149,12 @@ class AdmmSolver {
   AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                  Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
 
+  /// New values of C on its pattern (a loop whose constraints change values only, as the
+  /// projective global step's with each local step's scale factors): the next solve forms
+  /// K again, keeping everything that depends on the pattern. Throws Error(Usage) when C's
+  /// size or pattern (compressed) differs from the one given at construction.
+  void setConstraintValues(const SparseMatrix& C);
+
   const AdmmSettings& settings() const { return settings_; }
   double rho() const { return rho_; }
 
@@ -158,6 +168,9 @@ class AdmmSolver {
   std::vector<char> factoredEquality_;
   double factoredRho_ = 0.0;
 };
+
+/// Whether A and B are compressed and have the same size and the same nonzero positions.
+bool sameSparsityPattern(const SparseMatrix& A, const SparseMatrix& B);
 
 /// The host kernels: the Eigen loop, solving with `backend.createSpdSolver` (a prefactored
 /// Cholesky on the CPU backend). The default of Backend::createAdmmSolver.

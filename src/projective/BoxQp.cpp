@@ -57,6 +57,11 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
   admm_ = backend_.createAdmmSolver(P_, C_, static_cast<const compute::AdmmSettings&>(settings_));
 }
 
+void BoxQpSolver::setConstraintValues(const compute::SparseMatrix& C) {
+  admm_->setConstraintValues(C);
+  C_ = C;
+}
+
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
   Eigen::MatrixXd z;

@@ -68,6 +68,10 @@ class BoxQpSolver {
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
+  /// New values of C on the same pattern (compute::AdmmSolver::setConstraintValues): the
+  /// ADMM solver and everything it built for the pattern are kept.
+  void setConstraintValues(const compute::SparseMatrix& C);
+
   const BoxQpSettings& settings() const { return settings_; }
 
  private:

@@ -32,8 +32,7 @@ const char* toString(GlobalStepStatus status) {
 
 GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> constrained,
                        const GlobalStepSettings& settings)
-    : backend_(backend), space_(space), constrained_(std::move(constrained)), settings_(settings),
-      rho_(settings.qp.rho) {
+    : backend_(backend), space_(space), constrained_(std::move(constrained)), settings_(settings) {
   if (!(settings_.smoothness >= 0.0) || !std::isfinite(settings_.smoothness)) {
     throwUsage("global step: smoothness must be a finite number >= 0, got " + formatDouble(settings_.smoothness));
   }
@@ -149,10 +148,18 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
   }
 
-  BoxQpSettings qpSettings = settings_.qp;
-  qpSettings.rho = rho_;
-  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  BoxQpSolver qp(backend_, P_, C, qpSettings);
+  // One solver for the object's lifetime: C's pattern depends on the topology only, so later
+  // solves replace its values and keep what the solver built for the pattern (on the device:
+  // buffers, pipelines, K's pattern and the multigrid's aggregates). rho carries over from
+  // one solve to the next (the problems are alike).
+  if (qp_) {
+    qp_->setConstraintValues(C);
+  } else {
+    BoxQpSettings qpSettings = settings_.qp;
+    qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+    qp_ = std::make_unique<BoxQpSolver>(backend_, P_, C, qpSettings);
+  }
+  BoxQpSolver& qp = *qp_;
   Eigen::MatrixXd x = T;
   bool solved = false;
   for (double eps : schedule) {
@@ -174,7 +181,6 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
     info.linearIterations += qpInfo.linearIterations;
-    rho_ = qpInfo.rho;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
       throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
     }

@@ -28,6 +28,7 @@
 // Attempts whose eps is below what the ADMM's tolerances resolve stall (y drifts without a
 // certificate) and stop after a few hundred iterations (AdmmSettings::stallIterations).
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -124,7 +125,7 @@ class GlobalStep {
   GlobalStepSettings settings_;
   compute::SparseMatrix P_;
   std::vector<Row> rows_;
-  double rho_;  ///< Carried from one solve to the next (the problems are alike).
+  std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
 };
 
 }  // namespace plano::projective

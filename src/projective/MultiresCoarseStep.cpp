@@ -40,7 +40,7 @@ compute::SparseMatrix smoothnessMatrix(const ShapeSpace& space, double alpha) {
 
 MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> fixed,
                                        std::vector<MapPointConstraint> handles, const GlobalStepSettings& settings)
-    : backend_(backend), space_(space), handles_(std::move(handles)), settings_(settings), rho_(settings.qp.rho) {
+    : backend_(backend), space_(space), handles_(std::move(handles)), settings_(settings) {
   if (!(settings_.smoothness >= 0.0) || !std::isfinite(settings_.smoothness)) {
     throwUsage("coarse global step: smoothness must be a finite number >= 0, got " + number(settings_.smoothness));
   }
@@ -154,10 +154,16 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
   }
 
-  BoxQpSettings qpSettings = settings_.qp;
-  qpSettings.rho = rho_;
-  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  BoxQpSolver qp(backend_, P_, C, qpSettings);
+  // One solver for the object's lifetime (C's pattern depends on the topology and the
+  // handles only; see GlobalStep::solve); rho carries over.
+  if (qp_) {
+    qp_->setConstraintValues(C);
+  } else {
+    BoxQpSettings qpSettings = settings_.qp;
+    qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+    qp_ = std::make_unique<BoxQpSolver>(backend_, P_, C, qpSettings);
+  }
+  BoxQpSolver& qp = *qp_;
   Eigen::MatrixXd x = T;
   Eigen::MatrixXd y;
   bool solved = false;
@@ -176,7 +182,6 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
-    rho_ = qpInfo.rho;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
       throwNumerical("coarse global step: the ADMM iteration produced a non-finite value (eps " + number(eps) + ")");
     }

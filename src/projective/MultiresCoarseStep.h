@@ -10,6 +10,7 @@
 // targets and held fixed (for a point, shat = (p, 1) T_f[:, 3]), fourth columns taken from
 // the targets, three QPs for columns 0..2 sharing one matrix (BoxQp.h), the paper's ε
 // schedule on the compatibility rows only.
+#include <memory>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -51,7 +52,7 @@ class MultiresCoarseStep {
   GlobalStepSettings settings_;
   compute::SparseMatrix P_;
   std::vector<Row> rows_;
-  double rho_;
+  std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
 };
 
 }  // namespace plano::projective

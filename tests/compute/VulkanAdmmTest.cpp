@@ -261,6 +261,49 @@ TEST_F(VulkanAdmm, AnUncertifiedInfeasibleProblemStopsAsStalledOnBothBackends) {
   }
 }
 
+TEST_F(VulkanAdmm, NewConstraintValuesSolveAsAFreshSolverOnBothBackends) {
+  // A loop's second problem: C's values change on the same pattern (the projective global
+  // step's, with each local step's scale factors). The kept solver must solve it as a new
+  // one started at the rho it carries over.
+  const BoxQp first = randomBoxQp(60, 40, 11);
+  BoxQp second = first;
+  std::mt19937 random(12);
+  std::uniform_real_distribution<double> factor(0.5, 1.5);
+  for (Index i = 0; i < second.C.nonZeros(); ++i) second.C.valuePtr()[i] *= factor(random);
+  const compute::AdmmSettings settings = tightSettings();
+  compute::CpuBackend cpu;
+  auto freshAt = [&](double rho) {
+    compute::AdmmSettings atRho = settings;
+    atRho.rho = rho;
+    return runAdmm(cpu, second, atRho);
+  };
+
+  auto kept = cpu.createAdmmSolver(first.P, first.C, settings);
+  runAdmm(*kept, first);
+  const AdmmRun fresh = freshAt(kept->rho());
+  kept->setConstraintValues(second.C);
+  const AdmmRun host = runAdmm(*kept, second);
+  EXPECT_EQ(host.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(host.info.iterations, fresh.info.iterations);
+  EXPECT_LT(relativeDifference(host.x, fresh.x), 1e-12);
+
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    auto device = deviceSolver(context(), first, settings, recording);
+    runAdmm(*device, first);
+    const AdmmRun reference = freshAt(device->rho());
+    device->setConstraintValues(second.C);
+    const AdmmRun run = runAdmm(*device, second);
+    EXPECT_EQ(run.info.status, compute::AdmmStatus::Solved);
+    EXPECT_LE(std::abs(run.info.iterations - reference.info.iterations), settings.checkInterval);
+    EXPECT_LT(relativeDifference(run.x, reference.x), 1e-8);
+  }
+
+  const BoxQp otherPattern = randomBoxQp(60, 40, 13);
+  EXPECT_THROW(kept->setConstraintValues(otherPattern.C), Error);
+  EXPECT_THROW(kept->setConstraintValues(compute::SparseMatrix(41, 60)), Error);
+}
+
 TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
   BoxQp qp = randomBoxQp(40, 30, 3);
   qp.q(7, 1) = std::numeric_limits<double>::quiet_NaN();
@@ -336,6 +379,7 @@ class RecordingKernels final : public compute::AdmmKernels {
  public:
   RecordingKernels(std::unique_ptr<compute::AdmmKernels> inner, BoxQp& record) : inner_(std::move(inner)), record_(record) {}
   void setRho(const std::vector<char>& equality, double rho) override { inner_->setRho(equality, rho); }
+  void setConstraintValues(const compute::SparseMatrix& C) override { inner_->setConstraintValues(C); }
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     if (record_.q.size() == 0) {

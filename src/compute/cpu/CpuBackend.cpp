@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 #include <Eigen/SVD>
+#include <algorithm>
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
@@ -41,7 +42,16 @@ class CholmodSpdSolver final : public SpdSolver {
 
   bool refactor(const SparseMatrix& A) override {
     if (A.rows() != size_ || A.cols() != size_) return false;
-    columnMajor_ = A;
+    Eigen::SparseMatrix<double> columnMajor = A;
+    columnMajor.makeCompressed();
+    // The symbolic analysis holds for this pattern only.
+    if (columnMajor.nonZeros() != columnMajor_.nonZeros() ||
+        !std::equal(columnMajor.outerIndexPtr(), columnMajor.outerIndexPtr() + size_ + 1, columnMajor_.outerIndexPtr()) ||
+        !std::equal(columnMajor.innerIndexPtr(), columnMajor.innerIndexPtr() + columnMajor.nonZeros(),
+                    columnMajor_.innerIndexPtr())) {
+      return false;
+    }
+    columnMajor_ = std::move(columnMajor);
     factor_.factorize(columnMajor_);
     if (factor_.info() != Eigen::Success) {
       throwNumerical("SPD solver: Cholesky factorization failed (matrix not positive definite)");

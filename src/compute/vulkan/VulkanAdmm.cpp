@@ -270,6 +270,20 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   longFirstSolve_ = true;
 }
 
+void AdmmKernels::setConstraintValues(const compute::SparseMatrix& C) {
+  compute::SparseMatrix compressed = C;
+  compressed.makeCompressed();
+  if (!compute::sameSparsityPattern(compressed, C_)) {
+    throwUsage("ADMM: new constraint values on a different sparsity pattern");
+  }
+  C_ = std::move(compressed);
+  Ct_ = C_.transpose();
+  Ct_.makeCompressed();
+  devC_.values().upload({C_.valuePtr(), static_cast<std::size_t>(C_.nonZeros())});
+  devCt_.values().upload({Ct_.valuePtr(), static_cast<std::size_t>(Ct_.nonZeros())});
+  k1Uploaded_ = false;  // K1 = C^T D C is rebuilt at the next setRho
+}
+
 namespace {
 
 std::uint64_t longestRow(const compute::SparseMatrix& A) {

@@ -82,6 +82,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   ~AdmmKernels() override;
 
   void setRho(const std::vector<char>& equality, double rho) override;
+  /// Uploads C's and C^T's values; K1 (and the multigrid's coarse K1) follow at the next
+  /// setRho. Buffers, pipelines, recordings, K's pattern and the aggregates stay.
+  void setConstraintValues(const compute::SparseMatrix& C) override;
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
   void iterate(int count) override;
