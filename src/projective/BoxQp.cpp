@@ -148,4 +148,14 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
   return true;
 }
 
+BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
+                        const compute::SparseMatrix& C, const BoxQpSettings& settings) {
+  if (kept) {
+    kept->setConstraintValues(C);
+  } else {
+    kept = std::make_unique<BoxQpSolver>(backend, P, C, settings);
+  }
+  return *kept;
+}
+
 }  // namespace plano::projective

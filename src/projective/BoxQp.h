@@ -85,4 +85,13 @@ class BoxQpSolver {
   std::unique_ptr<compute::AdmmSolver> admm_;
 };
 
+/// The solver of a sequence of QPs whose C keeps one sparsity pattern (a loop's global
+/// steps: C's values follow each local step's scale factors, its pattern the topology):
+/// created by the first call, given C's new values by later ones, so that everything it
+/// built for the pattern is kept (on the device: buffers, pipelines, K's pattern, the
+/// multigrid's aggregates) and rho carries over from one problem to the next (they are
+/// alike). `settings` is used on creation only.
+BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
+                        const compute::SparseMatrix& C, const BoxQpSettings& settings);
+
 }  // namespace plano::projective

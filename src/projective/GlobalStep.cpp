@@ -148,18 +148,11 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
   }
 
-  // One solver for the object's lifetime: C's pattern depends on the topology only, so later
-  // solves replace its values and keep what the solver built for the pattern (on the device:
-  // buffers, pipelines, K's pattern and the multigrid's aggregates). rho carries over from
-  // one solve to the next (the problems are alike).
-  if (qp_) {
-    qp_->setConstraintValues(C);
-  } else {
-    BoxQpSettings qpSettings = settings_.qp;
-    qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-    qp_ = std::make_unique<BoxQpSolver>(backend_, P_, C, qpSettings);
-  }
-  BoxQpSolver& qp = *qp_;
+  // C's pattern depends on the topology (and the constrained vertices) only: one solver
+  // for the object's lifetime.
+  BoxQpSettings qpSettings = settings_.qp;
+  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, C, qpSettings);
   Eigen::MatrixXd x = T;
   bool solved = false;
   for (double eps : schedule) {

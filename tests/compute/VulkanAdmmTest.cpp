@@ -195,8 +195,8 @@ TEST_F(VulkanAdmm, EqualityOnlyProblemGivesTheHostSolution) {
   }
 }
 
-TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
-  // Rows 0 and 1 both measure x_0 + x_1 but ask for [0, 1] and [2, 3].
+/// Rows 0 and 1 both measure x_0 + x_1 but ask for [0, 1] and [2, 3]: infeasible.
+BoxQp conflictingRowsQp() {
   BoxQp qp = randomBoxQp(30, 12, 5);
   std::vector<Eigen::Triplet<double>> entries;
   for (Index i = 0; i < 12; ++i) {
@@ -212,6 +212,11 @@ TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
   qp.upper.row(0).setConstant(1.0);
   qp.lower.row(1).setConstant(2.0);
   qp.upper.row(1).setConstant(3.0);
+  return qp;
+}
+
+TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
+  const BoxQp qp = conflictingRowsQp();
   compute::CpuBackend cpu;
   compute::AdmmSettings settings;
   const AdmmRun host = runAdmm(cpu, qp, settings);
@@ -225,25 +230,10 @@ TEST_F(VulkanAdmm, InfeasibleBoundsGiveTheCertificateOnBothBackends) {
 }
 
 TEST_F(VulkanAdmm, AnUncertifiedInfeasibleProblemStopsAsStalledOnBothBackends) {
-  // Rows 0 and 1 both measure x_0 + x_1 but ask for [0, 1] and [2, 3], and the certificate
-  // is switched off (tolerance 0): as where an infeasibility is too slight for it (the
-  // global step's tiny-ε attempts), y only drifts, and without the stall rule the
-  // iteration runs to the cap.
-  BoxQp qp = randomBoxQp(30, 12, 5);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (Index i = 0; i < 12; ++i) {
-    entries.emplace_back(i, i < 2 ? 0 : i, 1.0);
-    entries.emplace_back(i, i < 2 ? 1 : i + 1, 1.0);
-  }
-  qp.C.resize(12, 30);
-  qp.C.setFromTriplets(entries.begin(), entries.end());
-  qp.C.makeCompressed();
-  qp.lower.setConstant(-1.0);
-  qp.upper.setConstant(1.0);
-  qp.lower.row(0).setConstant(0.0);
-  qp.upper.row(0).setConstant(1.0);
-  qp.lower.row(1).setConstant(2.0);
-  qp.upper.row(1).setConstant(3.0);
+  // The conflicting rows with the certificate switched off (tolerance 0): as where an
+  // infeasibility is too slight for it (the global step's tiny-ε attempts), y only
+  // drifts, and without the stall rule the iteration runs to the cap.
+  const BoxQp qp = conflictingRowsQp();
   compute::CpuBackend cpu;
   compute::AdmmSettings settings;
   settings.infeasibilityTolerance = 0.0;
