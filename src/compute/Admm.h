@@ -79,7 +79,7 @@ enum class AdmmStatus {
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
-  Stalled,              ///< Primal residual stuck above its tolerance, y diverging (AdmmSettings::stallIterations).
+  Stalled,              ///< Not converged and y drifting linearly (AdmmSettings::stallIterations).
 };
 
 struct AdmmInfo {
@@ -114,8 +114,8 @@ class AdmmKernels {
   virtual ~AdmmKernels() = default;
   /// Set K = P + sigma I + C^T diag(r) C with r_i = rho * (equality[i] ? scale : 1).
   virtual void setRho(const std::vector<char>& equality, double rho) = 0;
-  /// Replace C by a matrix with the same sparsity pattern (checked by AdmmSolver); K
-  /// changes at the next setRho. What depends on the pattern only (buffers, pipelines, K's
+  /// Replace C by a matrix with the same sparsity pattern (throws Error(Usage) otherwise);
+  /// K changes at the next setRho. What depends on the pattern only (buffers, pipelines, K's
   /// pattern, a factorization's analysis, a multigrid's aggregates) is kept.
   virtual void setConstraintValues(const SparseMatrix& C) = 0;
   /// Load q (n x k), bounds (m x k) and warm starts; z = clamp(C x, l, u), xTilde = x.

@@ -1,5 +1,5 @@
-// Device linear algebra against Eigen: SpMV, dot, axpby, row scaling, box projection and
-// the block-Jacobi inverses to 1e-12 relative.
+// Device linear algebra against Eigen: SpMV, dot, axpby, row scaling, box projection, value
+// gathers and the block-Jacobi inverses to 1e-12 relative.
 #include "compute/vulkan/VulkanLinearAlgebra.h"
 
 #include <Eigen/Dense>
@@ -187,6 +187,40 @@ TEST_F(VulkanLinearAlgebra, AxpbyScaleRowsAndCopyMatchEigen) {
   EXPECT_LT(relativeError(Yd, expectedY), 1e-12);
   EXPECT_LT(relativeError(Zd, d.asDiagonal() * expectedY), 1e-12);
   EXPECT_EQ(Wd, Zd);
+}
+
+TEST_F(VulkanLinearAlgebra, GatherSumAddsEachSourceIntoItsTargetLikeTheHost) {
+  // 20 000 sources into 3 000 destinations (some unused, some sources feeding nothing):
+  // the shape of a multigrid coarsening of matrix values.
+  const std::size_t sources = 20000;
+  const std::uint32_t count = 3000;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::int32_t> pick(-1, static_cast<std::int32_t>(count) - 1);
+  std::vector<std::int32_t> targets(sources);
+  for (std::int32_t& target : targets) target = pick(rng) % 2900;  // destinations 2900 .. 2999 stay empty
+  const Eigen::VectorXd values = randomBlock(static_cast<Index>(sources), 1, 12).col(0);
+  Eigen::VectorXd expected = Eigen::VectorXd::Zero(count);
+  for (std::size_t i = 0; i < sources; ++i) {
+    if (targets[i] >= 0) expected[targets[i]] += values[static_cast<Eigen::Index>(i)];
+  }
+  const vk::DeviceGather gather(context(), targets, count, "test gather");
+  vk::Array<double> source(context(), sources, vk::MemoryClass::Device, "source");
+  source.upload({values.data(), sources});
+  vk::Array<double> destination(context(), count, vk::MemoryClass::Device, "destination");
+  vk::Sequence s(context());
+  s.begin();
+  algebra().gatherSum(s, gather, source, destination);
+  s.end();
+  s.run();
+  Eigen::VectorXd actual(count);
+  destination.download({actual.data(), count});
+  EXPECT_LT(relativeError(actual, expected), 1e-14);
+  EXPECT_EQ(actual.tail(100), Eigen::VectorXd::Zero(100));
+
+  const std::vector<std::int32_t> outside{0, 5, static_cast<std::int32_t>(count)};
+  EXPECT_THROW(vk::DeviceGather(context(), outside, count, "bad gather"), Error);
+  vk::Array<double> tooShort(context(), count - 1, vk::MemoryClass::Device, "short");
+  EXPECT_THROW(algebra().gatherSum(s, gather, source, tooShort), Error);
 }
 
 TEST_F(VulkanLinearAlgebra, ClampProjectsOntoTheBox) {

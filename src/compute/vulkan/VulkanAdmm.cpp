@@ -85,6 +85,73 @@ compute::SparseMatrix unionPatternK0(const compute::SparseMatrix& P, const compu
   return K0;
 }
 
+struct K1AssemblePush {  // admm_k1_assemble
+  std::uint32_t nonZeros;
+};
+
+/// The terms of K1 = C^T D C on K's pattern: entry (i, j) of K sums C(r, i) D_r C(r, j)
+/// over the rows r of C that have both columns; a and b index C's stored values, listed per
+/// entry of K (CSR), and entryRows gives each stored value of C its row.
+struct K1Terms {
+  std::vector<std::int32_t> offsets, a, b, entryRows;
+};
+
+K1Terms k1Terms(const compute::SparseMatrix& C, const compute::SparseMatrix& K) {
+  K1Terms terms;
+  const std::int32_t* outer = C.outerIndexPtr();
+  const std::int32_t* inner = C.innerIndexPtr();
+  // Count per entry of K, then place (two passes: the term list is the largest array here).
+  std::vector<std::int64_t> offsets(static_cast<std::size_t>(K.nonZeros()) + 1, 0);
+  auto forEachTerm = [&](auto&& visit) {
+    for (Eigen::Index r = 0; r < C.rows(); ++r) {
+      for (std::int32_t p = outer[r]; p < outer[r + 1]; ++p) {
+        for (std::int32_t q = outer[r]; q < outer[r + 1]; ++q) {
+          const std::int32_t e = entryIndex(K, inner[p], inner[q]);
+          if (e < 0) throwDevice("Vulkan ADMM: K's pattern lacks an entry of C^T C");
+          visit(e, p, q);
+        }
+      }
+    }
+  };
+  forEachTerm([&](std::int32_t e, std::int32_t, std::int32_t) { ++offsets[static_cast<std::size_t>(e) + 1]; });
+  for (std::size_t e = 1; e < offsets.size(); ++e) offsets[e] += offsets[e - 1];
+  elementCount(offsets.back(), "the terms of C^T C");
+  terms.a.resize(static_cast<std::size_t>(offsets.back()));
+  terms.b.resize(terms.a.size());
+  std::vector<std::int64_t> next(offsets.begin(), offsets.end() - 1);
+  forEachTerm([&](std::int32_t e, std::int32_t p, std::int32_t q) {
+    const auto t = static_cast<std::size_t>(next[static_cast<std::size_t>(e)]++);
+    terms.a[t] = p;
+    terms.b[t] = q;
+  });
+  terms.offsets.assign(offsets.begin(), offsets.end());
+  terms.entryRows.resize(static_cast<std::size_t>(C.nonZeros()));
+  for (Eigen::Index r = 0; r < C.rows(); ++r) {
+    for (std::int32_t p = outer[r]; p < outer[r + 1]; ++p) terms.entryRows[static_cast<std::size_t>(p)] = static_cast<std::int32_t>(r);
+  }
+  return terms;
+}
+
+/// For each stored value of C, its position among C^T's (the gather that transposes values).
+std::vector<std::int32_t> transposeTargets(const compute::SparseMatrix& C) {
+  compute::SparseMatrix positions = C;
+  for (Eigen::Index e = 0; e < positions.nonZeros(); ++e) positions.valuePtr()[e] = static_cast<double>(e);
+  compute::SparseMatrix transposed = positions.transpose();
+  transposed.makeCompressed();
+  std::vector<std::int32_t> targets(static_cast<std::size_t>(C.nonZeros()));
+  for (Eigen::Index t = 0; t < transposed.nonZeros(); ++t) {
+    targets[static_cast<std::size_t>(transposed.valuePtr()[t])] = static_cast<std::int32_t>(t);
+  }
+  return targets;
+}
+
+/// A device array holding `values` (at least one element: Vulkan buffers are never empty).
+Array<std::int32_t> uploaded(Context& context, const std::vector<std::int32_t>& values, const char* what) {
+  Array<std::int32_t> array(context, std::max<std::size_t>(values.size(), 1), MemoryClass::Device, what);
+  if (!values.empty()) array.upload(values);
+  return array;
+}
+
 }  // namespace
 
 struct AdmmKernels::Workspace {
@@ -159,6 +226,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       devK_(context, K0_),
       k0Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K0 values"),
       k1Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K1 values"),
+      k1Assemble_(context, "admm_k1_assemble", 7, sizeof(K1AssemblePush)),
+      valuesUpdate_(context),
       block_(blockSize(settings.preconditionerBlock, n_)),
       inverseBlocks_(context, static_cast<std::size_t>(n_) * block_, MemoryClass::Device,
                      "ADMM preconditioner blocks"),
@@ -185,6 +254,19 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
   C_.makeCompressed();
   Ct_.makeCompressed();
   k0Values_.upload({K0_.valuePtr(), static_cast<std::size_t>(K0_.nonZeros())});
+  // What K1's and C^T's values are made of on the device, from the patterns (once).
+  {
+    const K1Terms terms = k1Terms(C_, K0_);
+    k1TermOffsets_ = uploaded(context, terms.offsets, "ADMM K1 term offsets");
+    k1TermA_ = uploaded(context, terms.a, "ADMM K1 terms");
+    k1TermB_ = uploaded(context, terms.b, "ADMM K1 terms");
+    cEntryRows_ = uploaded(context, terms.entryRows, "ADMM C entry rows");
+  }
+  transpose_ = std::make_unique<DeviceGather>(context, transposeTargets(C_),
+                                              elementCount(Ct_.nonZeros(), "C's entries"), "ADMM C^T values");
+  valuesUpdate_.begin();
+  algebra_.gatherSum(valuesUpdate_, *transpose_, devC_.values(), devCt_.values());
+  valuesUpdate_.end();
   const compute::BlockMultigridSettings multigridSettings{static_cast<int>(block_)};
   const bool multigrid =
       settings_.preconditioner == compute::AdmmPreconditioner::Multigrid ||
@@ -220,25 +302,27 @@ AdmmKernels::~AdmmKernels() = default;
 
 void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   if (equality.size() != m_) throwUsage("ADMM: equality flags for " + std::to_string(equality.size()) + " rows");
-  // A new equality pattern (at most once per solve) changes K1 = C^T D C: built here and
-  // uploaded. A rho update alone moves no mesh-sized data: K, the per-row penalties and
-  // the preconditioner's blocks are recomputed on the device; one flag comes back.
-  if (!k1Uploaded_ || equality != equality_) {
-    Eigen::VectorXd D(m_);
+  // A new equality pattern (at most once per solve) or new values of C change K1 = C^T D C
+  // and its coarse levels: assembled on the device from the row scales D, the only
+  // mesh-sized upload here. A rho update alone moves no mesh-sized data: K, the per-row
+  // penalties and the preconditioner's blocks are recomputed on the device; one flag
+  // comes back.
+  if (!k1Current_ || equality != equality_) {
+    std::vector<double> D(m_);
     for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
-    const compute::SparseMatrix CtDC = Ct_ * D.asDiagonal() * C_;
-    compute::SparseMatrix K1 = CtDC + K0_ * 0.0;  // onto the union pattern
-    K1.makeCompressed();
-    if (K1.nonZeros() != K0_.nonZeros() ||
-        !std::equal(K0_.innerIndexPtr(), K0_.innerIndexPtr() + K0_.nonZeros(), K1.innerIndexPtr()) ||
-        !std::equal(K0_.outerIndexPtr(), K0_.outerIndexPtr() + n_ + 1, K1.outerIndexPtr())) {
-      throwDevice("Vulkan ADMM: K0 and K1 do not share one sparsity pattern");
-    }
-    k1Values_.upload({K1.valuePtr(), static_cast<std::size_t>(K1.nonZeros())});
-    if (multigrid_) multigrid_->setK1(K1);
-    rowScales_.upload({D.data(), static_cast<std::size_t>(D.size())});
+    rowScales_.upload(D);
+    const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
+    assembly_.begin();
+    assembly_.dispatch(k1Assemble_,
+                       {k1TermOffsets_, k1TermA_, k1TermB_, devC_.values(), cEntryRows_, rowScales_, k1Values_},
+                       K1AssemblePush{nonZeros}, groupsFor(context_, nonZeros));
+    assembly_.barrier();
+    if (multigrid_) multigrid_->setK1(assembly_, k1Values_);
+    assembly_.end();
+    assembly_.run();
+    if (multigrid_) multigrid_->readCoarsestK1();
     equality_ = equality;
-    k1Uploaded_ = true;
+    k1Current_ = true;
   }
   const std::uint32_t noFailure = ~0u;
   blockFailure_.upload({&noFailure, 1});
@@ -277,11 +361,9 @@ void AdmmKernels::setConstraintValues(const compute::SparseMatrix& C) {
     throwUsage("ADMM: new constraint values on a different sparsity pattern");
   }
   C_ = std::move(compressed);
-  Ct_ = C_.transpose();
-  Ct_.makeCompressed();
   devC_.values().upload({C_.valuePtr(), static_cast<std::size_t>(C_.nonZeros())});
-  devCt_.values().upload({Ct_.valuePtr(), static_cast<std::size_t>(Ct_.nonZeros())});
-  k1Uploaded_ = false;  // K1 = C^T D C is rebuilt at the next setRho
+  valuesUpdate_.run();  // C^T's values
+  k1Current_ = false;   // K1 = C^T D C is assembled again at the next setRho
 }
 
 namespace {

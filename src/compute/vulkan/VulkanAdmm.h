@@ -7,8 +7,11 @@
 // K = P + sigma I + C^T diag(rho) C: rho takes two values (rho, rho * equalityRhoScale on
 // equality rows), so K = K0 + rho K1 with K0 = P + sigma I and K1 = C^T D C (D = 1 or
 // equalityRhoScale), both stored on the union sparsity pattern; a rho update is one
-// kernel (values), with no host refactorization. K1 is rebuilt on the
-// host only when the equality pattern changes.
+// kernel (values), with no host refactorization. K1 is assembled on the device
+// (shaders/admm_k1_assemble.comp, from C's values and the pairs of C's entries behind each
+// entry of K, listed once per pattern) when the equality pattern or C's values change, and
+// so are the multigrid's coarse K1 levels: new values of C cost their upload and nothing
+// else on the host.
 //
 // Inner solve: K xTilde = rhs by PCG warm-started from the previous xTilde, preconditioned
 // by the inverses of K's diagonal blocks (AdmmSettings::preconditionerBlock rows each; the
@@ -82,8 +85,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   ~AdmmKernels() override;
 
   void setRho(const std::vector<char>& equality, double rho) override;
-  /// Uploads C's and C^T's values; K1 (and the multigrid's coarse K1) follow at the next
-  /// setRho. Buffers, pipelines, recordings, K's pattern and the aggregates stay.
+  /// Uploads C's values (C^T's follow on the device); K1 and the multigrid's coarse K1
+  /// follow at the next setRho. Buffers, pipelines, recordings, K's pattern and the
+  /// aggregates stay.
   void setConstraintValues(const compute::SparseMatrix& C) override;
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
@@ -114,7 +118,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   compute::SparseMatrix Ct_;
   compute::SparseMatrix K0_;         ///< P + sigma I on the union pattern (host copy).
   std::vector<char> equality_;       ///< Rows of K1's D = equalityRhoScale.
-  bool k1Uploaded_ = false;          ///< k1Values_ and rowScales_ hold equality_'s K1 and D.
+  bool k1Current_ = false;           ///< k1Values_ and rowScales_ hold K1 and D of equality_ and C.
   LinearAlgebra algebra_;
   DeviceCsrMatrix devP_;
   DeviceCsrMatrix devC_;
@@ -122,6 +126,12 @@ class AdmmKernels final : public compute::AdmmKernels {
   DeviceCsrMatrix devK_;              ///< Values rewritten by every rho update.
   Array<double> k0Values_;
   Array<double> k1Values_;
+  /// K1's terms: for each entry of K, pairs (a, b) of C's entries in one row (CSR over K's
+  /// entries), and each entry of C's row; shaders/admm_k1_assemble.comp.
+  Array<std::int32_t> k1TermOffsets_, k1TermA_, k1TermB_, cEntryRows_;
+  std::unique_ptr<DeviceGather> transpose_;  ///< C's values -> C^T's.
+  Pipeline k1Assemble_;
+  Sequence valuesUpdate_;  ///< C^T's values from C's.
   std::uint32_t block_;               ///< Preconditioner block size (AdmmSettings::preconditionerBlock).
   Array<double> inverseBlocks_;      ///< n / block_ inverse diagonal blocks of K, row-major.
   Array<double> rhoRows_;            ///< rho per constraint row.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
 #include "core/Error.h"
@@ -96,6 +97,47 @@ std::vector<double> DeviceScalars::read() const {
   return all;
 }
 
+std::int32_t entryIndex(const compute::SparseMatrix& A, Index row, Index column) {
+  const int* begin = A.innerIndexPtr() + A.outerIndexPtr()[row];
+  const int* end = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
+  const int* found = std::lower_bound(begin, end, static_cast<int>(column));
+  return found != end && *found == column ? static_cast<std::int32_t>(found - A.innerIndexPtr()) : -1;
+}
+
+namespace {
+
+/// The CSR of a gather: for each destination, the sources that feed it, in increasing order.
+std::pair<std::vector<std::int32_t>, std::vector<std::int32_t>> gatherLists(std::span<const std::int32_t> targets,
+                                                                            std::uint32_t count) {
+  std::vector<std::int32_t> offsets(static_cast<std::size_t>(count) + 1, 0);
+  for (const std::int32_t target : targets) {
+    if (target < -1 || target >= static_cast<std::int64_t>(count)) {
+      throwUsage("gather: a target " + std::to_string(target) + " outside 0 .. " + std::to_string(count) + " - 1");
+    }
+    if (target >= 0) ++offsets[static_cast<std::size_t>(target) + 1];
+  }
+  for (std::size_t i = 1; i < offsets.size(); ++i) offsets[i] += offsets[i - 1];
+  std::vector<std::int32_t> indices(static_cast<std::size_t>(offsets.back()));
+  std::vector<std::int32_t> next(offsets.begin(), offsets.end() - 1);
+  for (std::size_t s = 0; s < targets.size(); ++s) {
+    if (targets[s] >= 0) indices[static_cast<std::size_t>(next[targets[s]]++)] = static_cast<std::int32_t>(s);
+  }
+  return {std::move(offsets), std::move(indices)};
+}
+
+}  // namespace
+
+DeviceGather::DeviceGather(Context& context, std::span<const std::int32_t> targets, std::uint32_t count,
+                           const char* what)
+    : count_(count),
+      sources_(elementCount(static_cast<std::int64_t>(targets.size()), what)),
+      offsets_(context, static_cast<std::size_t>(count) + 1, MemoryClass::Device, what),
+      indices_(context, std::max<std::size_t>(targets.size(), 1), MemoryClass::Device, what) {
+  const auto [offsets, indices] = gatherLists(targets, count);
+  offsets_.upload(offsets);
+  if (!indices.empty()) indices_.upload(indices);
+}
+
 LinearAlgebra::LinearAlgebra(Context& context)
     : context_(context),
       spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
@@ -106,7 +148,8 @@ LinearAlgebra::LinearAlgebra(Context& context)
       clamp_(context, "la_clamp", 4, sizeof(CountPush)),
       maxAbs_(context, "la_max_abs", 4, sizeof(MaxAbsPush)),
       reduceMax_(context, "la_reduce_max", 2, sizeof(ReducePush)),
-      blockInverse_(context, "block_jacobi_inverse", 5, sizeof(BlockInversePush)) {}
+      blockInverse_(context, "block_jacobi_inverse", 5, sizeof(BlockInversePush)),
+      gatherSum_(context, "la_gather_sum", 4, sizeof(CountPush)) {}
 
 void LinearAlgebra::spmv(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceVectors& X, DeviceVectors& Y) {
   if (X.n() != A.cols() || Y.n() != A.rows() || X.m() != Y.m()) {
@@ -208,6 +251,18 @@ void LinearAlgebra::clamp(Sequence& sequence, const DeviceVectors& X, const Devi
   requireSameShape(X, Y, "clamp");
   const std::uint32_t count = X.n() * X.m();
   sequence.dispatch(clamp_, {X.data(), L.data(), U.data(), Y.data()}, CountPush{count}, groupsFor(context_, count));
+  sequence.barrier();
+}
+
+void LinearAlgebra::gatherSum(Sequence& sequence, const DeviceGather& gather, const Array<double>& source,
+                              Array<double>& destination) {
+  if (source.count() < gather.sources() || destination.count() < gather.count()) {
+    throwUsage("gatherSum: " + std::to_string(source.count()) + " source and " + std::to_string(destination.count()) +
+               " destination values for a map of " + std::to_string(gather.sources()) + " to " +
+               std::to_string(gather.count()));
+  }
+  sequence.dispatch(gatherSum_, {gather.offsets(), gather.indices(), source, destination}, CountPush{gather.count()},
+                    groupsFor(context_, gather.count()));
   sequence.barrier();
 }
 

@@ -8,6 +8,7 @@
 // Sequence (each followed by a barrier) and run when the sequence runs; scalars such as
 // dot products stay on the device in DeviceScalars until the host asks for them.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -18,6 +19,10 @@ namespace plano::vk {
 /// `value` as a kernel's element count: the shaders index with 32-bit signed integers,
 /// so counts above 2^31 - 1 (or negative) are Error(Device) naming `what`.
 std::uint32_t elementCount(std::int64_t value, const char* what);
+
+/// Position of entry (row, column) among the stored entries of the compressed A, or -1:
+/// where a kernel writes a value of a fixed pattern.
+std::int32_t entryIndex(const compute::SparseMatrix& A, Index row, Index column);
 
 /// A compressed-row matrix on the device (uploaded once).
 class DeviceCsrMatrix {
@@ -38,6 +43,26 @@ class DeviceCsrMatrix {
   Array<std::int32_t> rowOffsets_;
   Array<std::int32_t> columns_;
   Array<double> values_;
+};
+
+/// A fixed sparse map between value arrays (LinearAlgebra::gatherSum), on the device:
+/// destination[i] = the sum of source[s] over the s with targets[s] == i, in increasing s.
+/// Made once from a pattern, applied to new values on the device (a coarse matrix's values
+/// from a fine one's, a transpose's from its matrix's).
+class DeviceGather {
+ public:
+  /// `targets`: one entry per source value, in 0 .. count - 1, or -1 where it feeds nothing.
+  DeviceGather(Context& context, std::span<const std::int32_t> targets, std::uint32_t count, const char* what);
+  std::uint32_t count() const { return count_; }
+  std::size_t sources() const { return sources_; }
+  const Array<std::int32_t>& offsets() const { return offsets_; }
+  const Array<std::int32_t>& indices() const { return indices_; }
+
+ private:
+  std::uint32_t count_;
+  std::size_t sources_;
+  Array<std::int32_t> offsets_;
+  Array<std::int32_t> indices_;
 };
 
 /// m column vectors of n entries each, column-major, on the device.
@@ -128,6 +153,9 @@ class LinearAlgebra {
              DeviceVectors& Y);
   /// Y = X (a device copy).
   void copy(Sequence& sequence, const DeviceVectors& X, DeviceVectors& Y);
+  /// destination = gather applied to source (DeviceGather).
+  void gatherSum(Sequence& sequence, const DeviceGather& gather, const Array<double>& source,
+                 Array<double>& destination);
 
   Context& context() { return context_; }
 
@@ -145,6 +173,7 @@ class LinearAlgebra {
   Pipeline maxAbs_;
   Pipeline reduceMax_;
   Pipeline blockInverse_;
+  Pipeline gatherSum_;
 };
 
 }  // namespace plano::vk

@@ -33,6 +33,22 @@ std::span<const double> valuesOf(const compute::SparseMatrix& A) {
   return {A.valuePtr(), static_cast<std::size_t>(A.nonZeros())};
 }
 
+/// For each entry of the fine pattern, the coarse entry it adds into under the
+/// aggregation's prolongation (row b i + k -> b a_i + k, columns alike).
+std::vector<std::int32_t> coarseEntries(const compute::SparseMatrix& fine, const compute::SparseMatrix& coarse,
+                                        const std::vector<Index>& aggregate, Index b) {
+  std::vector<std::int32_t> targets(static_cast<std::size_t>(fine.nonZeros()));
+  for (Index row = 0; row < fine.rows(); ++row) {
+    const Index coarseRow = b * aggregate[row / b] + row % b;
+    for (Index e = fine.outerIndexPtr()[row]; e < fine.outerIndexPtr()[row + 1]; ++e) {
+      const Index column = fine.innerIndexPtr()[e];
+      targets[e] = entryIndex(coarse, coarseRow, b * aggregate[column / b] + column % b);
+      if (targets[e] < 0) throwDevice("Vulkan multigrid: a fine entry has no coarse entry");
+    }
+  }
+  return targets;
+}
+
 }  // namespace
 
 struct Multigrid::Level {
@@ -114,18 +130,53 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
     patterns_.push_back(patternLevels[l]);
     levels_.push_back(std::move(level));
   }
+  for (int l = 0; l + 1 < L; ++l) {
+    const std::vector<std::int32_t> targets =
+        coarseEntries(patterns_[l], patterns_[l + 1], aggregation_.aggregates(l), block_);
+    coarsenings_.push_back(std::make_unique<DeviceGather>(
+        context, targets, elementCount(patterns_[l + 1].nonZeros(), "a multigrid level's entries"),
+        "multigrid coarsening"));
+  }
+  coarsestK1Values_ = std::make_unique<Array<double>>(context, static_cast<std::size_t>(patterns_.back().nonZeros()),
+                                                      MemoryClass::Device, "multigrid coarsest K1 values");
 }
 
 Multigrid::~Multigrid() = default;
 
+void Multigrid::setK1(Sequence& sequence, const Array<double>& k1) {
+  const int L = levelCount();
+  if (L == 1) {
+    sequence.copy(k1, *coarsestK1Values_, coarsestK1Values_->count() * sizeof(double));
+    sequence.barrier();
+    return;
+  }
+  for (int l = 0; l + 1 < L; ++l) {
+    const Array<double>& fine = l == 0 ? k1 : *levels_[l]->k1;
+    Array<double>& coarse = l + 2 == L ? *coarsestK1Values_ : *levels_[l + 1]->k1;
+    algebra_.gatherSum(sequence, *coarsenings_[l], fine, coarse);
+  }
+}
+
+void Multigrid::readCoarsestK1() {
+  coarsestK1_ = patterns_.back();
+  coarsestK1Values_->download({coarsestK1_.valuePtr(), static_cast<std::size_t>(coarsestK1_.nonZeros())});
+  k1Set_ = true;
+}
+
 void Multigrid::setK1(const compute::SparseMatrix& K1) {
-  const std::vector<compute::SparseMatrix> k1Levels = aggregation_.coarsen(onPattern(K1, patterns_.front()));
-  for (int l = 1; l + 1 < levelCount(); ++l) levels_[l]->k1->upload(valuesOf(onPattern(k1Levels[l], patterns_[l])));
-  coarsestK1_ = k1Levels.back();
+  const compute::SparseMatrix values = onPattern(K1, patterns_.front());
+  Array<double> k1(context_, static_cast<std::size_t>(values.nonZeros()), MemoryClass::Device, "multigrid K1 values");
+  k1.upload(valuesOf(values));
+  Sequence sequence(context_);
+  sequence.begin();
+  setK1(sequence, k1);
+  sequence.end();
+  sequence.run();
+  readCoarsestK1();
 }
 
 void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure) {
-  if (coarsestK1_.rows() == 0) throwUsage("multigrid: setRho before setK1");
+  if (!k1Set_) throwUsage("multigrid: setRho before setK1");
   for (int l = 1; l + 1 < levelCount(); ++l) {
     Level& level = *levels_[l];
     const auto nonZeros = static_cast<std::uint32_t>(level.k0->count());

@@ -3,9 +3,11 @@
 // of the ADMM's inner PCG with K = K0 + rho K1.
 //
 // The levels' aggregates are fixed when the solver is built; the coarse matrices are
-// Galerkin products, and since coarsening is linear, K_l = K0_l + rho K1_l with K0_l and
-// K1_l coarsened once on the host (K0 per solver, K1 when the equality pattern changes,
-// like the ADMM's own K1). A rho update is then device work only: K_l on every level
+// Galerkin products, and since coarsening is linear, K_l = K0_l + rho K1_l with K0_l
+// coarsened once on the host and K1_l on the device whenever K1 changes: with piecewise
+// constant prolongation every fine entry adds into one coarse entry, so a level's values
+// are a fixed gather of the finer level's (DeviceGather, built once from the patterns).
+// A rho update is then device work only: K_l on every level
 // (admm_assemble) and the block-Jacobi inverses of every level but the coarsest
 // (block_jacobi_inverse); the coarsest level (at most BlockMultigridSettings::coarsestBlocks
 // blocks) is inverted densely on the host from its two small matrices and uploaded, a
@@ -36,7 +38,13 @@ class Multigrid {
   Multigrid(const Multigrid&) = delete;
   Multigrid& operator=(const Multigrid&) = delete;
 
-  /// K1 on level 0's pattern: coarsen and upload it (a new equality pattern).
+  /// Record the coarse levels' K1 from level 0's K1 values (on the caller's `pattern`,
+  /// already on the device); once the sequence ran, readCoarsestK1() fetches the coarsest
+  /// level's values (a small matrix, for its dense inverse at each rho update).
+  void setK1(Sequence& sequence, const Array<double>& k1);
+  void readCoarsestK1();
+  /// The same from a host matrix on level 0's pattern (uploads it; tests and callers
+  /// without K1 on the device).
   void setK1(const compute::SparseMatrix& K1);
   /// Record K_l = K0_l + rho K1_l on the coarse levels and the block inverses of levels
   /// 1 .. L-2 into `sequence` (level 0's are the caller's); upload the coarsest inverse.
@@ -78,6 +86,9 @@ class Multigrid {
   std::vector<compute::SparseMatrix> patterns_;  ///< Level patterns (values 0), levels 1 ..
   std::vector<std::unique_ptr<Level>> levels_;   ///< Levels 0 .. L-1 (level 0 holds only temporaries).
   compute::SparseMatrix coarsestK0_, coarsestK1_;
+  std::vector<std::unique_ptr<DeviceGather>> coarsenings_;  ///< Level l's values -> level l + 1's.
+  std::unique_ptr<Array<double>> coarsestK1Values_;        ///< On the coarsest level's pattern.
+  bool k1Set_ = false;
   Pipeline spmv_, scale_, axpby_, restrict_, prolong_, assemble_;
   Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
 };
