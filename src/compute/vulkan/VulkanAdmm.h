@@ -1,5 +1,6 @@
 #pragma once
-// The ADMM iteration of compute/Admm.h on the device. P, C and C^T are uploaded once; x,
+// The ADMM iteration of compute/Admm.h on the device. P and the patterns of C and C^T are
+// uploaded once (C's values again for each new problem of a loop, setConstraintValues); x,
 // y, z and the problem data stay on the device for a whole solve, and between two checks
 // one recorded command buffer runs the checkInterval iterations: only the check's
 // per-column inf-norms (a few dozen doubles) come back.
