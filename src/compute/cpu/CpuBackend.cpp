@@ -46,7 +46,8 @@ class CholmodSpdSolver final : public SpdSolver {
     columnMajor.makeCompressed();
     // The symbolic analysis holds for this pattern only.
     if (columnMajor.nonZeros() != columnMajor_.nonZeros() ||
-        !std::equal(columnMajor.outerIndexPtr(), columnMajor.outerIndexPtr() + size_ + 1, columnMajor_.outerIndexPtr()) ||
+        !std::equal(columnMajor.outerIndexPtr(), columnMajor.outerIndexPtr() + size_ + 1,
+                    columnMajor_.outerIndexPtr()) ||
         !std::equal(columnMajor.innerIndexPtr(), columnMajor.innerIndexPtr() + columnMajor.nonZeros(),
                     columnMajor_.innerIndexPtr())) {
       return false;

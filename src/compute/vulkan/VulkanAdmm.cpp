@@ -127,7 +127,9 @@ K1Terms k1Terms(const compute::SparseMatrix& C, const compute::SparseMatrix& K) 
   terms.offsets.assign(offsets.begin(), offsets.end());
   terms.entryRows.resize(static_cast<std::size_t>(C.nonZeros()));
   for (Eigen::Index r = 0; r < C.rows(); ++r) {
-    for (std::int32_t p = outer[r]; p < outer[r + 1]; ++p) terms.entryRows[static_cast<std::size_t>(p)] = static_cast<std::int32_t>(r);
+    for (std::int32_t p = outer[r]; p < outer[r + 1]; ++p) {
+      terms.entryRows[static_cast<std::size_t>(p)] = static_cast<std::int32_t>(r);
+    }
   }
   return terms;
 }
