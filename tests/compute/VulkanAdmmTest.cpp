@@ -625,5 +625,25 @@ TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
   EXPECT_LT(worst, 1e-6);  // measured 2e-7 on lavapipe: see the file comment
 }
 
+TEST_F(VulkanAdmm, AGlobalStepWithoutConstraintRowsKeepsItsTargetsWithoutValidationMessages) {
+  // A lone face and no constrained vertex: C has no rows, the device vectors of the rows
+  // are empty (a zero-sized copy is a validation error), twice (the kept solver).
+  PolygonMesh quad;
+  quad.vertices.resize(4, 3);
+  quad.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  quad.faces.addFace({0, 1, 2, 3});
+  const projective::ShapeSpace space(quad);
+  projective::GlobalStep step(backend(), space, {});
+  std::vector<Eigen::Matrix4d> targets(1, Eigen::Matrix4d::Identity());
+  targets[0](0, 1) = 0.1;
+  projective::FaceMaps maps;
+  for (int solve = 0; solve < 2; ++solve) {
+    const projective::GlobalStepInfo info = step.solve(targets, Positions(), maps);
+    EXPECT_EQ(info.status, projective::GlobalStepStatus::Unchanged);
+    ASSERT_EQ(maps.maps.size(), 1u);
+    EXPECT_EQ(maps.maps[0], targets[0]);
+  }
+}
+
 }  // namespace
 }  // namespace plano::test

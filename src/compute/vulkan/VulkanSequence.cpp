@@ -92,6 +92,7 @@ void Sequence::barrier() {
 void Sequence::copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset,
                     std::size_t destinationOffset) {
   if (!recording_) throwDevice("Vulkan: buffer copy outside begin()/end()");
+  if (bytes == 0) return;  // Vulkan forbids empty copy regions (empty vectors: no constraint rows)
   VkBufferCopy region{sourceOffset, destinationOffset, bytes};
   vkCmdCopyBuffer(commands_, source.handle(), destination.handle(), 1, &region);
 }
