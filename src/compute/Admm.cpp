@@ -171,6 +171,11 @@ void AdmmSolver::setConstraintValues(const SparseMatrix& C) {
   factored_ = false;
 }
 
+void AdmmSolver::setRho(double rho) {
+  if (!(rho > 0.0) || !std::isfinite(rho)) throwUsage("ADMM: rho must be a finite number > 0");
+  rho_ = rho;
+}
+
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                            Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
   const Eigen::Index k = q.cols();

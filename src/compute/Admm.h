@@ -155,7 +155,13 @@ class AdmmSolver {
   /// size or pattern (compressed) differs from the one given at construction.
   void setConstraintValues(const SparseMatrix& C);
 
+  /// The rho the next solve starts at (by default the last solve's final rho): a caller
+  /// rewinds it after a solve whose rho ran off (projective/GlobalStep.cpp). Throws
+  /// Error(Usage) unless rho is finite and > 0.
+  void setRho(double rho);
+
   const AdmmSettings& settings() const { return settings_; }
+  /// The rho the next solve starts at.
   double rho() const { return rho_; }
 
  private:

@@ -71,6 +71,9 @@ class BoxQpSolver {
   /// New values of C on the same pattern (compute::AdmmSolver::setConstraintValues): the
   /// ADMM solver and everything it built for the pattern are kept.
   void setConstraintValues(const compute::SparseMatrix& C);
+  /// The rho the next solve starts at (compute::AdmmSolver::rho, setRho).
+  double rho() const { return admm_->rho(); }
+  void setRho(double rho) { admm_->setRho(rho); }
 
   const BoxQpSettings& settings() const { return settings_; }
 

@@ -294,6 +294,41 @@ TEST_F(VulkanAdmm, NewConstraintValuesSolveAsAFreshSolverOnBothBackends) {
   EXPECT_THROW(kept->setConstraintValues(compute::SparseMatrix(41, 60)), Error);
 }
 
+TEST_F(VulkanAdmm, ASetRhoStartsTheNextSolveThereOnBothBackends) {
+  // A caller rewinds rho after a solve whose rho ran off: the next solve is a new solver's
+  // started at that rho, on the host and on the device.
+  const BoxQp qp = randomBoxQp(24, 16, 21);
+  const compute::AdmmSettings settings = tightSettings();
+  compute::CpuBackend cpu;
+  const double rewound = 3.0 * settings.rho;
+  compute::AdmmSettings atRho = settings;
+  atRho.rho = rewound;
+  const AdmmRun fresh = runAdmm(cpu, qp, atRho);
+
+  auto kept = cpu.createAdmmSolver(qp.P, qp.C, settings);
+  runAdmm(*kept, qp);
+  ASSERT_NE(kept->rho(), rewound);
+  kept->setRho(rewound);
+  EXPECT_EQ(kept->rho(), rewound);
+  const AdmmRun host = runAdmm(*kept, qp);
+  EXPECT_EQ(host.info.iterations, fresh.info.iterations);
+  EXPECT_LT(relativeDifference(host.x, fresh.x), 1e-12);
+
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    auto device = deviceSolver(context(), qp, settings, recording);
+    runAdmm(*device, qp);
+    device->setRho(rewound);
+    const AdmmRun run = runAdmm(*device, qp);
+    EXPECT_LE(std::abs(run.info.iterations - fresh.info.iterations), settings.checkInterval);
+    EXPECT_LT(relativeDifference(run.x, fresh.x), 1e-8);
+  }
+
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_THROW(kept->setRho(bad), Error) << bad;
+  }
+}
+
 TEST_F(VulkanAdmm, NanInQGivesNonFinite) {
   BoxQp qp = randomBoxQp(40, 30, 3);
   qp.q(7, 1) = std::numeric_limits<double>::quiet_NaN();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
@@ -104,6 +105,42 @@ TEST_F(GlobalStepTest, PositionalConstraintsHoldAndTheScheduleIsRecorded) {
   for (std::size_t i = 0; i < constrained.size(); ++i) {
     EXPECT_LT((p.row(constrained[i]) - at.row(i)).norm(), 1e-9 * space.normalization().scale) << "vertex " << constrained[i];
   }
+}
+
+TEST_F(GlobalStepTest, AnAttemptAfterAStalledOneStartsAtTheStalledOnesRho) {
+  // The boundary of a grid fixed and its centre lifted: no compatible maps with the
+  // targets' scale factors meet that within a small eps. With an infeasibility tolerance
+  // too coarse to certify it, the small eps's attempt stalls, its rho driven far up. The
+  // next attempt starts at the rho the stalled one started at (here the initial rho), so
+  // the eps that solves gives the ADMM iteration of a step that tries it first.
+  const PolygonMesh mesh = generate::translationalSurface(6, 6);
+  const ShapeSpace space(mesh);
+  std::vector<Index> constrained;
+  for (Index v = 0; v < space.vertexCount(); ++v) {
+    const Index i = v % 7, j = v / 7;
+    if (i == 0 || j == 0 || i == 6 || j == 6) constrained.push_back(v);
+  }
+  constrained.push_back(24);  // the centre, (3, 3)
+  Positions at(constrained.size(), 3);
+  for (std::size_t i = 0; i < constrained.size(); ++i) at.row(i) = mesh.vertices.row(constrained[i]);
+  at.bottomRows(1) += Eigen::RowVector3d(0.0, 0.0, 1e-4);
+  GlobalStepSettings settings;
+  settings.qp.infeasibilityTolerance = 1e-2;
+  GlobalStep scheduled(backend, space, constrained, settings);
+  FaceMaps afterStall;
+  const GlobalStepInfo first = scheduled.solve(space.identityMaps().maps, at, afterStall);
+  ASSERT_EQ(first.attempts.size(), 2u);
+  ASSERT_EQ(first.attempts.front().status, BoxQpStatus::Stalled);
+  ASSERT_EQ(first.attempts.back().status, BoxQpStatus::Solved);
+
+  settings.initialEpsilonFraction *= settings.epsilonGrowth;
+  GlobalStep direct(backend, space, constrained, settings);
+  FaceMaps fresh;
+  const GlobalStepInfo second = direct.solve(space.identityMaps().maps, at, fresh);
+  ASSERT_EQ(second.attempts.size(), 1u);
+  EXPECT_NEAR(second.epsilon, first.epsilon, 1e-12 * first.epsilon);
+  EXPECT_EQ(second.attempts.front().iterations, first.attempts.back().iterations);
+  EXPECT_LT(maxMapDifference(fresh.maps, afterStall.maps), 1e-12);
 }
 
 TEST_F(GlobalStepTest, ExactFirstGivesExactlyPlanarFacesWhenFeasible) {

@@ -66,6 +66,25 @@ TEST_F(SubdivisionPq, CubeThreeCatmullClarkLevelsEndPlanarInAtMostNineIterations
   EXPECT_LT(relativeDistance(fine.vertices, linearOnly(cube, SubdivisionScheme::CatmullClark, 3)), 0.02);
 }
 
+TEST_F(SubdivisionPq, HexagonalDomeTwoCatmullClarkLevelsConvergeWithoutCappedAttempts) {
+  // A stalled attempt drives rho to its clamp; when the next eps's attempt started there,
+  // level 2 ran 13 local/global iterations (15 in all, 102 550 ADMM iterations, most
+  // attempts to the cap). The next attempt now starts at the stalled one's starting rho:
+  // 3 iterations (1 + 2), 8 060 ADMM iterations.
+  PqSubdivisionSettings settings;
+  settings.levels = 2;
+  const PqSubdivisionResult result = subdividePlanarQuads(backend, generate::hexagonalDome(2), settings);
+  EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+  EXPECT_LE(result.info.totalIterations, 5);
+  for (const PqLevelInfo& level : result.info.levels) {
+    EXPECT_LT(level.planarity.max, 0.1) << "level " << level.level;
+    for (const PqIteration& it : level.iterations) {
+      // No attempt ran to the cap (one that did spends the cap in its iteration alone).
+      EXPECT_LT(it.admmIterations, settings.globalStep.qp.maxIterations) << "level " << level.level;
+    }
+  }
+}
+
 TEST_F(SubdivisionPq, CubeThreeFourPointLevelsEndBelowHalfAPercent) {
   PqSubdivisionSettings settings;
   settings.levels = 3;
