@@ -16,6 +16,7 @@
 #include "projective/Deformation.h"
 #include "projective/GlobalStep.h"
 #include "projective/LocalStep.h"
+#include "projective/ScaledConstraintMatrix.h"
 
 namespace {
 
@@ -145,6 +146,40 @@ plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeS
   return C;
 }
 
+/// Host work of a global step's constraint matrix per step: assembled from triplets (what
+/// the steps did before) or its values filled into the pattern built once
+/// (ScaledConstraintMatrix, what they do now).
+void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
+  const plano::PolygonMesh mesh = grid(state);
+  const plano::projective::ShapeSpace space(mesh);
+  std::vector<plano::projective::ScaledConstraintMatrix::Term> terms;
+  const auto& offsets = space.vertexCornerOffsets();
+  const auto& corners = space.cornersOfVertex();
+  Index rows = 0;
+  for (Index v = 0; v < space.vertexCount(); ++v) {
+    const Eigen::RowVector4d p = plano::projective::homogeneous(space.basePositions().row(v));
+    for (Index k = offsets[v] + 1; k < offsets[v + 1]; ++k, ++rows) {
+      terms.push_back({rows, space.cornerFace(corners[offsets[v]]), p, corners[offsets[v]]});
+      terms.push_back({rows, space.cornerFace(corners[k]), -p, corners[k]});
+    }
+  }
+  plano::projective::ScaledConstraintMatrix matrix(rows, space.faceCount(), terms);
+  std::mt19937 random(1);
+  std::uniform_real_distribution<double> scale(0.8, 1.2);
+  std::vector<double> shat(space.cornerCount());
+  for (double& value : shat) value = scale(random);
+  unsigned seed = 0;
+  for (auto _ : state) {
+    if (fill) {
+      benchmark::DoNotOptimize(matrix.fill(shat).valuePtr());
+    } else {
+      const plano::compute::SparseMatrix C = compatibilityMatrix(space, ++seed);
+      benchmark::DoNotOptimize(C.valuePtr());
+    }
+  }
+  setCounters(state, mesh);
+}
+
 /// What a projective global step pays before its first ADMM iteration, with a new ADMM
 /// solver per step (`new_solver`: buffers, pipelines, K's pattern, the multigrid's
 /// aggregates and coarse patterns) or with the solver kept from the previous step and
@@ -199,6 +234,10 @@ BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_new_solver, BackendChoice::Vulkan, false)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, true)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
+    ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GlobalStepConstraints, filled, true)
+    ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DeformationIteration, cpu, BackendChoice::Cpu)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan, BackendChoice::Vulkan)

@@ -60,6 +60,17 @@ GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::
     }
   }
 
+  std::vector<ScaledConstraintMatrix::Term> terms;
+  terms.reserve(2 * rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const Row& row = rows_[r];
+    const Eigen::RowVector4d p = homogeneous(space_.basePositions().row(row.vertex));
+    const auto i = static_cast<Index>(r);
+    terms.push_back({i, space_.cornerFace(row.cornerA), p, row.cornerA});
+    if (row.cornerB >= 0) terms.push_back({i, space_.cornerFace(row.cornerB), -p, row.cornerB});
+  }
+  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), terms);
+
   // P = I + alpha * (L kron I_4): ||A_f - A_g||^2 per column adds alpha to the (f, f),
   // (g, g) blocks and -alpha to the (f, g), (g, f) blocks of each of the 4 entries.
   const Index n = 4 * space_.faceCount();
@@ -107,33 +118,23 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     }
   }
 
-  // C_s and d for columns 0..2 (d differs per column only on positional rows).
+  // C_s (values 1/shat of each row's corners) and d for columns 0..2 (d differs per column
+  // only on positional rows).
   const auto m = static_cast<Eigen::Index>(rows_.size());
   const Index n = 4 * faceCount;
-  const Positions& base = space_.basePositions();
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(rows_.size() * 8);
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
   std::vector<char> positional(m, 0);
   for (Eigen::Index r = 0; r < m; ++r) {
     const Row& row = rows_[r];
-    const Eigen::RowVector4d p = homogeneous(base.row(row.vertex));
-    const Index fa = space_.cornerFace(row.cornerA);
-    for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fa + k, p[k] / shat[row.cornerA]);
-    if (row.cornerB >= 0) {
-      const Index fb = space_.cornerFace(row.cornerB);
-      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fb + k, -p[k] / shat[row.cornerB]);
-    } else {
-      positional[r] = 1;
-      const Eigen::RowVector3d q = space_.normalization().toNormalized(Eigen::RowVector3d(positions.row(row.constrainedSlot)));
-      if (!q.allFinite()) {
-        throwBadInput("global step: the position of constrained vertex " + std::to_string(row.vertex) + " is not finite");
-      }
-      d.row(r) = q;
+    if (row.cornerB >= 0) continue;
+    positional[r] = 1;
+    const Eigen::RowVector3d q = space_.normalization().toNormalized(Eigen::RowVector3d(positions.row(row.constrainedSlot)));
+    if (!q.allFinite()) {
+      throwBadInput("global step: the position of constrained vertex " + std::to_string(row.vertex) + " is not finite");
     }
+    d.row(r) = q;
   }
-  compute::SparseMatrix C(m, n);
-  C.setFromTriplets(entries.begin(), entries.end());
+  const compute::SparseMatrix& C = constraints_.fill(shat);
 
   Eigen::MatrixXd T(n, 3);
   for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();

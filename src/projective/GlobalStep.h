@@ -34,6 +34,7 @@
 
 #include "compute/Backend.h"
 #include "projective/BoxQp.h"
+#include "projective/ScaledConstraintMatrix.h"
 #include "projective/ShapeSpace.h"
 
 namespace plano::projective {
@@ -125,6 +126,7 @@ class GlobalStep {
   GlobalStepSettings settings_;
   compute::SparseMatrix P_;
   std::vector<Row> rows_;
+  ScaledConstraintMatrix constraints_;  ///< C_s: its pattern once, its values per solve.
   std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
 };
 

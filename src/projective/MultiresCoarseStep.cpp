@@ -80,6 +80,23 @@ MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpa
   for (std::size_t h = 0; h < handles_.size(); ++h) {
     rows_.push_back({RowKind::MapPoint, -1, -1, -1, static_cast<Index>(h)});
   }
+  // Scales: the corners' reciprocal scale factors, then one per handle (its point's).
+  std::vector<ScaledConstraintMatrix::Term> terms;
+  terms.reserve(2 * rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const Row& row = rows_[r];
+    const auto i = static_cast<Index>(r);
+    if (row.kind == RowKind::MapPoint) {
+      const MapPointConstraint& h = handles_[row.handle];
+      const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
+      terms.push_back({i, h.face, p, space_.cornerCount() + row.handle});
+      continue;
+    }
+    const Eigen::RowVector4d p = homogeneous(space_.basePositions().row(row.vertex));
+    terms.push_back({i, space_.cornerFace(row.cornerA), p, row.cornerA});
+    if (row.kind == RowKind::Compatibility) terms.push_back({i, space_.cornerFace(row.cornerB), -p, row.cornerB});
+  }
+  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), terms);
   P_ = smoothnessMatrix(space_, settings_.smoothness);
 }
 
@@ -106,9 +123,8 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
 
   const auto m = static_cast<Eigen::Index>(rows_.size());
   const Index n = 4 * faceCount;
-  const Positions& base = space_.basePositions();
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(rows_.size() * 8);
+  std::vector<double> scales = shat;
+  scales.resize(shat.size() + handles_.size());
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
   std::vector<char> relaxed(m, 0);
   for (Eigen::Index r = 0; r < m; ++r) {
@@ -121,23 +137,15 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
         throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
                        std::to_string(h.handle) + " to infinity");
       }
-      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * h.face + k, p[k] / scale);
+      scales[shat.size() + row.handle] = scale;
       d.row(r) = h.target.transpose();
-      continue;
-    }
-    const Eigen::RowVector4d p = homogeneous(base.row(row.vertex));
-    const Index fa = space_.cornerFace(row.cornerA);
-    for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fa + k, p[k] / shat[row.cornerA]);
-    if (row.kind == RowKind::Compatibility) {
+    } else if (row.kind == RowKind::Compatibility) {
       relaxed[r] = 1;
-      const Index fb = space_.cornerFace(row.cornerB);
-      for (int k = 0; k < 4; ++k) entries.emplace_back(r, 4 * fb + k, -p[k] / shat[row.cornerB]);
     } else {
-      d.row(r) = base.row(row.vertex);
+      d.row(r) = space_.basePositions().row(row.vertex);
     }
   }
-  compute::SparseMatrix C(m, n);
-  C.setFromTriplets(entries.begin(), entries.end());
+  const compute::SparseMatrix& C = constraints_.fill(scales);
 
   Eigen::MatrixXd T(n, 3);
   for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();

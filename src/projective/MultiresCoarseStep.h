@@ -16,6 +16,7 @@
 #include "compute/Backend.h"
 #include "projective/GlobalStep.h"
 #include "projective/MultiresConstraints.h"
+#include "projective/ScaledConstraintMatrix.h"
 #include "projective/ShapeSpace.h"
 
 namespace plano::projective {
@@ -52,6 +53,7 @@ class MultiresCoarseStep {
   GlobalStepSettings settings_;
   compute::SparseMatrix P_;
   std::vector<Row> rows_;
+  ScaledConstraintMatrix constraints_;  ///< C: its pattern once, its values per solve.
   std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
 };
 
