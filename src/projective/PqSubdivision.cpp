@@ -53,6 +53,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.epsilon = step.epsilon;
     record.constraintResidual = step.constraintResidual;
     record.admmIterations = step.admmIterations;
+    record.attempts = step.attempts;
     record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
     record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;
     info.iterations.push_back(record);

@@ -30,6 +30,16 @@ TEST(SubdivisionCommand, WritesThePlanarQuadMeshAndAReportPerLevel) {
   int iterations = 0;
   for (const auto& level : report["levels"]) {
     EXPECT_EQ(level["epsilons"].size(), level["iterations"].get<std::size_t>());
+    for (const auto& step : level["steps"]) {
+      // The ε schedule of each step, ending with the attempt that solved at the step's ε.
+      const auto& attempts = step["epsilon_attempts"];
+      ASSERT_FALSE(attempts.empty());
+      EXPECT_EQ(attempts.back()["status"], "solved");
+      EXPECT_EQ(attempts.back()["epsilon"].get<double>(), step["epsilon"].get<double>());
+      int admm = 0;
+      for (const auto& attempt : attempts) admm += attempt["iterations"].get<int>();
+      EXPECT_EQ(admm, step["admm_iterations"].get<int>());
+    }
     EXPECT_LT(level["planarity"]["max"].get<double>(), 0.1);
     iterations += level["iterations"].get<int>();
   }

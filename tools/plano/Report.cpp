@@ -14,6 +14,14 @@ nlohmann::json planarityJson(const PlanarityStats& stats) {
           {"max_plane_fit_residual", stats.maxPlaneFitResidual}};
 }
 
+nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>& attempts) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& a : attempts) {
+    list.push_back({{"epsilon", a.epsilon}, {"status", projective::toString(a.status)}, {"iterations", a.iterations}});
+  }
+  return list;
+}
+
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,
                           const PlanarityStats& planarity, double seconds) {
   return {{"command", command},

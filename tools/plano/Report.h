@@ -8,10 +8,14 @@
 #include "core/Error.h"
 #include "mesh/Planarity.h"
 #include "mesh/PolygonMesh.h"
+#include "projective/GlobalStep.h"
 
 namespace plano::cli {
 
 nlohmann::json planarityJson(const PlanarityStats& stats);
+
+/// A global step's ε schedule: [{epsilon, status, iterations}] in the order tried.
+nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>& attempts);
 
 /// The common keys of a report for a command that produced `mesh`.
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,

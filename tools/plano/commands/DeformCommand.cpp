@@ -58,10 +58,6 @@ struct DeformOutcome {
 };
 
 nlohmann::json iterationJson(const projective::DeformationIteration& it) {
-  nlohmann::json attempts = nlohmann::json::array();
-  for (const auto& a : it.attempts) {
-    attempts.push_back({{"epsilon", a.epsilon}, {"status", projective::toString(a.status)}, {"iterations", a.iterations}});
-  }
   return {{"iteration", it.iteration},
           {"phase", it.phase == projective::DeformationPhase::Ideal ? "ideal" : "projection"},
           {"epsilon", it.epsilon},
@@ -71,7 +67,7 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
           {"admm_iterations", it.admmIterations},
           {"displacement", it.displacement},
           {"max_planarity", it.maxPlanarity},
-          {"epsilon_attempts", attempts}};
+          {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};
 }
 
 DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& global, compute::Backend& backend,
@@ -186,10 +182,6 @@ DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& glo
   for (const auto& check : info.levelChecks) {
     checks.push_back({{"level", check.level}, {"admissible", check.admissible}, {"reason", check.reason}});
   }
-  nlohmann::json fineAttempts = nlohmann::json::array();
-  for (const auto& a : info.fineStep.attempts) {
-    fineAttempts.push_back({{"epsilon", a.epsilon}, {"status", projective::toString(a.status)}, {"iterations", a.iterations}});
-  }
   outcome.details = {{"method", "multires"},
                      {"energy", options.energy},
                      {"scheme", options.scheme},
@@ -204,7 +196,7 @@ DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& glo
                      {"epsilon", info.coarseEpsilons},
                      {"displacements", info.coarseDisplacements},
                      {"fine_epsilon", info.fineStep.epsilon},
-                     {"fine_epsilon_attempts", fineAttempts},
+                     {"fine_epsilon_attempts", epsilonAttemptsJson(info.fineStep.attempts)},
                      {"projection_iterations", info.projectionIterations},
                      {"max_handle_error", info.maxHandleError},
                      {"max_fixed_error", info.maxFixedError},

@@ -36,7 +36,8 @@ nlohmann::json levelJson(const projective::PqLevelInfo& level) {
                      {"max_planarity", it.maxPlanarity},
                      {"max_change", it.maxChange},
                      {"constraint_residual", it.constraintResidual},
-                     {"admm_iterations", it.admmIterations}});
+                     {"admm_iterations", it.admmIterations},
+                     {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}});
   }
   return {{"level", level.level},
           {"vertices", level.vertices},
