@@ -119,14 +119,20 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
   state.counters["admm_iterations"] = admm;
 }
 
-/// The global step's constraint matrix on a grid (one row per pair of a vertex's first and
-/// another corner, as GlobalStep builds it) with reciprocal scale factors drawn in
-/// [0.8, 1.2]: the values one local step gives.
-plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeSpace& space, unsigned seed) {
+/// Reciprocal scale factors in [0.8, 1.2], one per corner.
+std::vector<double> randomScales(const plano::projective::ShapeSpace& space, unsigned seed) {
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> scale(0.8, 1.2);
   std::vector<double> shat(space.cornerCount());
   for (double& value : shat) value = scale(random);
+  return shat;
+}
+
+/// The global step's constraint matrix on a grid (one row per pair of a vertex's first and
+/// another corner, as GlobalStep builds it) with reciprocal scale factors drawn in
+/// [0.8, 1.2]: the values one local step gives.
+plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeSpace& space, unsigned seed) {
+  const std::vector<double> shat = randomScales(space, seed);
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::Index row = 0;
   const auto& offsets = space.vertexCornerOffsets();
@@ -146,12 +152,8 @@ plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeS
   return C;
 }
 
-/// Host work of a global step's constraint matrix per step: assembled from triplets (what
-/// the steps did before) or its values filled into the pattern built once
-/// (ScaledConstraintMatrix, what they do now).
-void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
-  const plano::PolygonMesh mesh = grid(state);
-  const plano::projective::ShapeSpace space(mesh);
+/// The same matrix as a ScaledConstraintMatrix (its pattern once, values per step).
+plano::projective::ScaledConstraintMatrix scaledCompatibilityMatrix(const plano::projective::ShapeSpace& space) {
   std::vector<plano::projective::ScaledConstraintMatrix::Term> terms;
   const auto& offsets = space.vertexCornerOffsets();
   const auto& corners = space.cornersOfVertex();
@@ -163,11 +165,17 @@ void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
       terms.push_back({rows, space.cornerFace(corners[k]), -p, corners[k]});
     }
   }
-  plano::projective::ScaledConstraintMatrix matrix(rows, space.faceCount(), terms);
-  std::mt19937 random(1);
-  std::uniform_real_distribution<double> scale(0.8, 1.2);
-  std::vector<double> shat(space.cornerCount());
-  for (double& value : shat) value = scale(random);
+  return {rows, space.faceCount(), space.cornerCount(), terms};
+}
+
+/// Host work of a global step's constraint matrix per step: assembled from triplets (what
+/// the steps did before) or its values filled into the pattern built once
+/// (ScaledConstraintMatrix, what they do now).
+void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
+  const plano::PolygonMesh mesh = grid(state);
+  const plano::projective::ShapeSpace space(mesh);
+  plano::projective::ScaledConstraintMatrix matrix = scaledCompatibilityMatrix(space);
+  const std::vector<double> shat = randomScales(space, 1);
   unsigned seed = 0;
   for (auto _ : state) {
     if (fill) {
@@ -183,9 +191,13 @@ void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
 /// What a projective global step pays before its first ADMM iteration, with a new ADMM
 /// solver per step (`new_solver`: buffers, pipelines, K's pattern, the multigrid's
 /// aggregates and coarse patterns) or with the solver kept from the previous step and
-/// given C's new values (`kept_solver`, what GlobalStep does). Both then form K on the
-/// first solve (rho update) and load the problem; the ADMM iterations are excluded (cap 0).
-void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, bool keep) {
+/// given C's new values (`kept_solver`) or new scales of its entries, one per corner, from
+/// which the backend forms the values (`kept_scales`, what GlobalStep does). All then form
+/// K on the first solve (rho update) and load the problem; the ADMM iterations are
+/// excluded (cap 0).
+enum class SolverReuse { New, KeptValues, KeptScales };
+
+void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, SolverReuse reuse) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   const plano::PolygonMesh mesh = grid(state);
@@ -200,13 +212,15 @@ void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, bool keep) {
   const Eigen::MatrixXd q = Eigen::MatrixXd::Ones(P.rows(), 3);
   const Eigen::MatrixXd bounds = Eigen::MatrixXd::Zero(C[0].rows(), 3);
   std::unique_ptr<plano::compute::AdmmSolver> solver = backend->createAdmmSolver(P, C[0], settings);
+  const std::vector<double> scales[2] = {randomScales(space, 1), randomScales(space, 2)};
+  if (reuse == SolverReuse::KeptScales) solver->setConstraintScaling(scaledCompatibilityMatrix(space).scaling());
   int step = 0;
   for (auto _ : state) {
-    const plano::compute::SparseMatrix& values = C[++step % 2];
-    if (keep) {
-      solver->setConstraintValues(values);
-    } else {
-      solver = backend->createAdmmSolver(P, values, settings);
+    const int which = ++step % 2;
+    switch (reuse) {
+      case SolverReuse::New: solver = backend->createAdmmSolver(P, C[which], settings); break;
+      case SolverReuse::KeptValues: solver->setConstraintValues(C[which]); break;
+      case SolverReuse::KeptScales: solver->setConstraintScales(scales[which]); break;
     }
     Eigen::MatrixXd x, y, z;
     solver->solve(q, bounds, bounds, x, y, z);
@@ -226,13 +240,15 @@ BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
     ->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan, BackendChoice::Vulkan)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_new_solver, BackendChoice::Cpu, false)
+BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_new_solver, BackendChoice::Cpu, SolverReuse::New)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_kept_solver, BackendChoice::Cpu, true)
+BENCHMARK_CAPTURE(BM_AdmmSetup, cpu_kept_solver, BackendChoice::Cpu, SolverReuse::KeptValues)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_new_solver, BackendChoice::Vulkan, false)
+BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_new_solver, BackendChoice::Vulkan, SolverReuse::New)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, true)
+BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, SolverReuse::KeptValues)
+    ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_scales, BackendChoice::Vulkan, SolverReuse::KeptScales)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);

@@ -58,6 +58,19 @@ class HostAdmmKernels final : public AdmmKernels {
     Ct_ = C_.transpose();
   }
 
+  void setConstraintScaling(const ConstraintScaling& scaling) override {
+    checkConstraintScaling(scaling, C_.nonZeros());
+    scaling_ = scaling;
+  }
+
+  void setConstraintScales(std::span<const double> scales) override {
+    double* values = C_.valuePtr();
+    for (std::size_t e = 0; e < scaling_.coefficients.size(); ++e) {
+      values[e] = scaling_.coefficients[e] / scales[static_cast<std::size_t>(scaling_.scaleOf[e])];
+    }
+    Ct_ = C_.transpose();
+  }
+
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     q_ = q;
@@ -122,6 +135,7 @@ class HostAdmmKernels final : public AdmmKernels {
   Backend& backend_;
   AdmmSettings settings_;
   SparseMatrix P_, C_, Ct_;
+  ConstraintScaling scaling_;
   std::unique_ptr<SpdSolver> solver_;
   Eigen::VectorXd rho_;
   Eigen::MatrixXd q_, lower_, upper_, x_, y_, z_, xTilde_, yPrevious_;
@@ -168,6 +182,36 @@ void AdmmSolver::setConstraintValues(const SparseMatrix& C) {
                " for a " + std::to_string(m_) + "x" + std::to_string(n_) + " C");
   }
   kernels_->setConstraintValues(C);
+  factored_ = false;
+}
+
+void checkConstraintScaling(const ConstraintScaling& scaling, Eigen::Index nonZeros) {
+  const auto entries = static_cast<std::size_t>(nonZeros);
+  if (scaling.coefficients.size() != entries || scaling.scaleOf.size() != entries) {
+    throwUsage("ADMM: a constraint scaling of " + std::to_string(scaling.coefficients.size()) + " coefficients and " +
+               std::to_string(scaling.scaleOf.size()) + " scale indices for a C of " + std::to_string(entries) +
+               " entries");
+  }
+  for (const std::int32_t s : scaling.scaleOf) {
+    if (s < 0 || s >= scaling.scaleCount) {
+      throwUsage("ADMM: a constraint scaling's scale index " + std::to_string(s) + " is outside 0 .. " +
+                 std::to_string(scaling.scaleCount - 1));
+    }
+  }
+}
+
+void AdmmSolver::setConstraintScaling(ConstraintScaling scaling) {
+  kernels_->setConstraintScaling(scaling);
+  scaleCount_ = scaling.scaleCount;
+}
+
+void AdmmSolver::setConstraintScales(std::span<const double> scales) {
+  if (scaleCount_ < 0) throwUsage("ADMM: constraint scales given before a constraint scaling");
+  if (scales.size() != static_cast<std::size_t>(scaleCount_)) {
+    throwUsage("ADMM: " + std::to_string(scales.size()) + " constraint scales for a scaling of " +
+               std::to_string(scaleCount_));
+  }
+  kernels_->setConstraintScales(scales);
   factored_ = false;
 }
 

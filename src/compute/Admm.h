@@ -14,7 +14,9 @@
 //    Eigen loop with a Backend SPD solver; the Vulkan kernels record the same steps as
 //    compute shaders, so between two checks nothing but the block's submit crosses the bus.
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -93,6 +95,20 @@ struct AdmmInfo {
   long inexactSolves = 0;      ///< Solves with K stopped by an iteration cap (iterative backends).
 };
 
+/// C's values as coefficients[e] / scales[scaleOf[e]] over its stored entries, in its
+/// compressed order (the projective global steps' C: a base coordinate over a corner's
+/// reciprocal scale factor, projective/ScaledConstraintMatrix.h). Given once to a solver,
+/// after which one scale per corner, not C's values, changes C (AdmmSolver::setConstraintScales).
+struct ConstraintScaling {
+  std::vector<double> coefficients;  ///< One per stored entry of C.
+  std::vector<std::int32_t> scaleOf; ///< One per stored entry of C, in 0 .. scaleCount - 1.
+  std::int32_t scaleCount = 0;
+};
+
+/// Throws Error(Usage) unless `scaling` has one coefficient and scale index per entry of a
+/// C with `nonZeros` entries, each index in range.
+void checkConstraintScaling(const ConstraintScaling& scaling, Eigen::Index nonZeros);
+
 /// Per-column inf-norms at the current iterate (vectors of k entries); all a check needs.
 /// dy = y - y at the start of the last iteration (zero before the first iteration).
 struct AdmmMeasures {
@@ -118,6 +134,12 @@ class AdmmKernels {
   /// K changes at the next setRho. What depends on the pattern only (buffers, pipelines, K's
   /// pattern, a factorization's analysis, a multigrid's aggregates) is kept.
   virtual void setConstraintValues(const SparseMatrix& C) = 0;
+  /// Keep C's values as this scaling of its entries (checkConstraintScaling against C's
+  /// entries: Error(Usage)); setConstraintScales then forms them where C lives.
+  virtual void setConstraintScaling(const ConstraintScaling& scaling) = 0;
+  /// C's values from new scales (scaling.scaleCount of them, checked by the caller); as
+  /// setConstraintValues, K changes at the next setRho.
+  virtual void setConstraintScales(std::span<const double> scales) = 0;
   /// Load q (n x k), bounds (m x k) and warm starts; z = clamp(C x, l, u), xTilde = x.
   virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                      const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
@@ -154,6 +176,12 @@ class AdmmSolver {
   /// K again, keeping everything that depends on the pattern. Throws Error(Usage) when C's
   /// size or pattern (compressed) differs from the one given at construction.
   void setConstraintValues(const SparseMatrix& C);
+  /// C's values as a scaling of its entries from now on (ConstraintScaling; checked against
+  /// C's entry count, Error(Usage)), then new values by their scales: on the device one
+  /// scale per corner crosses instead of C's values. Throws Error(Usage) for scales given
+  /// before a scaling or of another count.
+  void setConstraintScaling(ConstraintScaling scaling);
+  void setConstraintScales(std::span<const double> scales);
 
   /// The rho the next solve starts at (by default the last solve's final rho): a caller
   /// rewinds it after a solve whose rho ran off (projective/GlobalStep.cpp). Throws
@@ -173,6 +201,7 @@ class AdmmSolver {
   bool factored_ = false;
   std::vector<char> factoredEquality_;
   double factoredRho_ = 0.0;
+  std::int32_t scaleCount_ = -1;  ///< Of the scaling given, -1 before one.
 };
 
 /// Whether A and B are compressed and have the same size and the same nonzero positions.

@@ -50,6 +50,7 @@ const char* toString(BoxQpStatus status) {
 BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, compute::SparseMatrix C,
                          const BoxQpSettings& settings)
     : backend_(backend), settings_(settings), P_(std::move(P)), C_(std::move(C)) {
+  C_.makeCompressed();
   if (P_.rows() != P_.cols() || C_.cols() != P_.rows()) {
     throwUsage("box QP: P is " + std::to_string(P_.rows()) + "x" + std::to_string(P_.cols()) + " and C is " +
                std::to_string(C_.rows()) + "x" + std::to_string(C_.cols()) + " (need n x n and m x n)");
@@ -60,6 +61,19 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
 void BoxQpSolver::setConstraintValues(const compute::SparseMatrix& C) {
   admm_->setConstraintValues(C);
   C_ = C;
+}
+
+void BoxQpSolver::setConstraintScaling(const compute::ConstraintScaling& scaling) {
+  admm_->setConstraintScaling(scaling);
+}
+
+void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales) {
+  // C comes from the matrix whose scaling the solver holds (one pattern): the sizes suffice.
+  if (C.rows() != C_.rows() || C.cols() != C_.cols() || C.nonZeros() != C_.nonZeros() || !C.isCompressed()) {
+    throwUsage("box QP: new constraint values on a different sparsity pattern");
+  }
+  admm_->setConstraintScales(scales);
+  std::copy_n(C.valuePtr(), C.nonZeros(), C_.valuePtr());
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -149,11 +163,12 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
 }
 
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
-                        const compute::SparseMatrix& C, const BoxQpSettings& settings) {
+                        const ScaledConstraintMatrix& C, std::span<const double> scales, const BoxQpSettings& settings) {
   if (kept) {
-    kept->setConstraintValues(C);
+    kept->setScaledConstraintValues(C.matrix(), scales);
   } else {
-    kept = std::make_unique<BoxQpSolver>(backend, P, C, settings);
+    kept = std::make_unique<BoxQpSolver>(backend, P, C.matrix(), settings);
+    kept->setConstraintScaling(C.scaling());
   }
   return *kept;
 }

@@ -16,9 +16,11 @@
 // tolerance from the answer.
 #include <Eigen/Core>
 #include <memory>
+#include <span>
 
 #include "compute/Admm.h"
 #include "compute/Backend.h"
+#include "projective/ScaledConstraintMatrix.h"
 
 namespace plano::projective {
 
@@ -71,6 +73,11 @@ class BoxQpSolver {
   /// New values of C on the same pattern (compute::AdmmSolver::setConstraintValues): the
   /// ADMM solver and everything it built for the pattern are kept.
   void setConstraintValues(const compute::SparseMatrix& C);
+  /// C's values as a scaling of its entries from now on (compute::AdmmSolver::
+  /// setConstraintScaling), then new values by their scales: the ADMM forms them where it
+  /// runs, and C (its values for those scales) serves the polish here.
+  void setConstraintScaling(const compute::ConstraintScaling& scaling);
+  void setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales);
   /// The rho the next solve starts at (compute::AdmmSolver::rho, setRho).
   double rho() const { return admm_->rho(); }
   void setRho(double rho) { admm_->setRho(rho); }
@@ -90,11 +97,11 @@ class BoxQpSolver {
 
 /// The solver of a sequence of QPs whose C keeps one sparsity pattern (a loop's global
 /// steps: C's values follow each local step's scale factors, its pattern the topology):
-/// created by the first call, given C's new values by later ones, so that everything it
-/// built for the pattern is kept (on the device: buffers, pipelines, K's pattern, the
-/// multigrid's aggregates) and rho carries over from one problem to the next (they are
-/// alike). `settings` is used on creation only.
+/// created by the first call, given C's new scales by later ones (C, filled for `scales`,
+/// must be their values), so that everything it built for the pattern is kept (on the
+/// device: buffers, pipelines, K's pattern, the multigrid's aggregates) and rho carries
+/// over from one problem to the next (they are alike). `settings` is used on creation only.
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
-                        const compute::SparseMatrix& C, const BoxQpSettings& settings);
+                        const ScaledConstraintMatrix& C, std::span<const double> scales, const BoxQpSettings& settings);
 
 }  // namespace plano::projective

@@ -69,7 +69,7 @@ GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::
     terms.push_back({i, space_.cornerFace(row.cornerA), p, row.cornerA});
     if (row.cornerB >= 0) terms.push_back({i, space_.cornerFace(row.cornerB), -p, row.cornerB});
   }
-  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), terms);
+  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), space_.cornerCount(), terms);
 
   // P = I + alpha * (L kron I_4): ||A_f - A_g||^2 per column adds alpha to the (f, f),
   // (g, g) blocks and -alpha to the (f, g), (g, f) blocks of each of the 4 entries.
@@ -153,7 +153,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   // for the object's lifetime.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, C, qpSettings);
+  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
   Eigen::MatrixXd x = T;
   bool solved = false;
   for (double eps : schedule) {

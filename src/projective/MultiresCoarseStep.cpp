@@ -96,7 +96,8 @@ MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpa
     terms.push_back({i, space_.cornerFace(row.cornerA), p, row.cornerA});
     if (row.kind == RowKind::Compatibility) terms.push_back({i, space_.cornerFace(row.cornerB), -p, row.cornerB});
   }
-  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), terms);
+  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(),
+                                        space_.cornerCount() + static_cast<Index>(handles_.size()), terms);
   P_ = smoothnessMatrix(space_, settings_.smoothness);
 }
 
@@ -166,7 +167,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
   // for the object's lifetime.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, C, qpSettings);
+  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
   Eigen::MatrixXd x = T;
   Eigen::MatrixXd y;
   bool solved = false;

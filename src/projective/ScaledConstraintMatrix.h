@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "compute/Admm.h"
 #include "compute/Backend.h"
 
 namespace plano::projective {
@@ -27,19 +28,23 @@ class ScaledConstraintMatrix {
   };
 
   ScaledConstraintMatrix() = default;
-  /// C is rows x 4 faces. Throws Error(Usage) for a term outside C, a negative scale
-  /// index, or two terms on the same entry.
-  ScaledConstraintMatrix(Index rows, Index faces, const std::vector<Term>& terms);
+  /// C is rows x 4 faces; fill() takes `scales` scales. Throws Error(Usage) for a term
+  /// outside C, a scale index outside 0 .. scales - 1, or two terms on the same entry.
+  ScaledConstraintMatrix(Index rows, Index faces, Index scales, const std::vector<Term>& terms);
 
-  /// C's values for these scales (one per scale index; the terms' indices must be below
-  /// scales.size(), else Error(Usage)). The matrix stays valid until the next fill.
+  /// C's values for these scales (exactly as many as given to the constructor, else
+  /// Error(Usage)). The matrix stays valid until the next fill.
   const compute::SparseMatrix& fill(std::span<const double> scales);
+
+  /// C as last filled (zero values before the first fill).
+  const compute::SparseMatrix& matrix() const { return C_; }
+  /// The coefficient and scale index of every stored entry of C (compressed order), for a
+  /// solver that forms C's values itself (compute::AdmmSolver::setConstraintScaling).
+  const compute::ConstraintScaling& scaling() const { return scaling_; }
 
  private:
   compute::SparseMatrix C_;
-  std::vector<double> coefficients_;  ///< Per stored entry of C, in its compressed order.
-  std::vector<Index> scaleOf_;        ///< Per stored entry of C.
-  Index scaleCount_ = 0;              ///< Largest scale index + 1.
+  compute::ConstraintScaling scaling_;
 };
 
 }  // namespace plano::projective

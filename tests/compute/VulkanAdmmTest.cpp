@@ -294,6 +294,60 @@ TEST_F(VulkanAdmm, NewConstraintValuesSolveAsAFreshSolverOnBothBackends) {
   EXPECT_THROW(kept->setConstraintValues(compute::SparseMatrix(41, 60)), Error);
 }
 
+TEST_F(VulkanAdmm, ConstraintScalesGiveTheSolveOfTheirValuesOnBothBackends) {
+  // C's values as coefficient / scale per entry (the projective global steps' form): after
+  // the scaling is given once, new scales must solve as the values they stand for, given
+  // directly. On the device the values are formed there from one scale per index.
+  const BoxQp first = randomBoxQp(24, 16, 31);
+  const auto entries = static_cast<std::size_t>(first.C.nonZeros());
+  compute::ConstraintScaling scaling;
+  scaling.scaleCount = 17;
+  scaling.coefficients.assign(first.C.valuePtr(), first.C.valuePtr() + entries);
+  for (std::size_t e = 0; e < entries; ++e) scaling.scaleOf.push_back(static_cast<std::int32_t>((7 * e) % 17));
+  std::mt19937 random(32);
+  std::uniform_real_distribution<double> factor(0.5, 1.5);
+  std::vector<double> scales(17);
+  for (double& s : scales) s = factor(random);
+  BoxQp second = first;
+  for (std::size_t e = 0; e < entries; ++e) second.C.valuePtr()[e] = scaling.coefficients[e] / scales[scaling.scaleOf[e]];
+  const compute::AdmmSettings settings = tightSettings();
+  compute::CpuBackend cpu;
+
+  auto byValues = cpu.createAdmmSolver(first.P, first.C, settings);
+  runAdmm(*byValues, first);
+  byValues->setConstraintValues(second.C);
+  const AdmmRun reference = runAdmm(*byValues, second);
+  EXPECT_EQ(reference.info.status, compute::AdmmStatus::Solved);
+
+  auto byScales = cpu.createAdmmSolver(first.P, first.C, settings);
+  EXPECT_THROW(byScales->setConstraintScales(scales), Error);  // before a scaling
+  runAdmm(*byScales, first);
+  byScales->setConstraintScaling(scaling);
+  byScales->setConstraintScales(scales);
+  const AdmmRun host = runAdmm(*byScales, second);
+  EXPECT_EQ(host.info.iterations, reference.info.iterations);
+  EXPECT_LT(relativeDifference(host.x, reference.x), 1e-12);
+
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    auto device = deviceSolver(context(), first, settings, recording);
+    runAdmm(*device, first);
+    device->setConstraintScaling(scaling);
+    device->setConstraintScales(scales);
+    const AdmmRun run = runAdmm(*device, second);
+    EXPECT_LE(std::abs(run.info.iterations - reference.info.iterations), settings.checkInterval);
+    EXPECT_LT(relativeDifference(run.x, reference.x), 1e-8);
+  }
+
+  EXPECT_THROW(byScales->setConstraintScales(std::vector<double>(16, 1.0)), Error);
+  compute::ConstraintScaling fewer = scaling;
+  fewer.coefficients.pop_back();
+  EXPECT_THROW(byScales->setConstraintScaling(fewer), Error);
+  compute::ConstraintScaling outOfRange = scaling;
+  outOfRange.scaleOf[3] = 17;
+  EXPECT_THROW(byScales->setConstraintScaling(outOfRange), Error);
+}
+
 TEST_F(VulkanAdmm, ASetRhoStartsTheNextSolveThereOnBothBackends) {
   // A caller rewinds rho after a solve whose rho ran off: the next solve is a new solver's
   // started at that rho, on the host and on the device.
@@ -405,6 +459,8 @@ class RecordingKernels final : public compute::AdmmKernels {
   RecordingKernels(std::unique_ptr<compute::AdmmKernels> inner, BoxQp& record) : inner_(std::move(inner)), record_(record) {}
   void setRho(const std::vector<char>& equality, double rho) override { inner_->setRho(equality, rho); }
   void setConstraintValues(const compute::SparseMatrix& C) override { inner_->setConstraintValues(C); }
+  void setConstraintScaling(const compute::ConstraintScaling& scaling) override { inner_->setConstraintScaling(scaling); }
+  void setConstraintScales(std::span<const double> scales) override { inner_->setConstraintScales(scales); }
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     if (record_.q.size() == 0) {

@@ -43,7 +43,7 @@ compute::SparseMatrix assembled(Index rows, Index faces, const std::vector<Term>
 TEST(ScaledConstraintMatrix, FilledValuesEqualTheAssembledMatrixOnOneFixedPattern) {
   const Index rows = 40, faces = 12, scales = 30;
   const std::vector<Term> terms = randomTerms(rows, faces, scales, 3);
-  ScaledConstraintMatrix matrix(rows, faces, terms);
+  ScaledConstraintMatrix matrix(rows, faces, scales, terms);
   std::mt19937 random(4);
   std::uniform_real_distribution<double> scale(0.5, 1.5);
   compute::SparseMatrix first;
@@ -59,7 +59,7 @@ TEST(ScaledConstraintMatrix, FilledValuesEqualTheAssembledMatrixOnOneFixedPatter
   }
 }
 
-TEST(ScaledConstraintMatrix, BadTermsAndTooFewScalesAreUsageErrors) {
+TEST(ScaledConstraintMatrix, BadTermsAndAWrongScaleCountAreUsageErrors) {
   const Eigen::RowVector4d p(1.0, 2.0, 3.0, 1.0);
   auto kindOf = [](auto&& make) -> std::optional<ErrorKind> {
     try {
@@ -69,11 +69,13 @@ TEST(ScaledConstraintMatrix, BadTermsAndTooFewScalesAreUsageErrors) {
     }
     return std::nullopt;
   };
-  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, {{0, 0, p, 0}, {0, 0, -p, 1}}); }), ErrorKind::Usage);
-  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, {{2, 0, p, 0}}); }), ErrorKind::Usage);
-  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, {{0, 2, p, 0}}); }), ErrorKind::Usage);
-  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, {{0, 0, p, -1}}); }), ErrorKind::Usage);
-  ScaledConstraintMatrix matrix(2, 2, {{0, 0, p, 0}, {1, 1, p, 3}});
+  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, 4, {{0, 0, p, 0}, {0, 0, -p, 1}}); }), ErrorKind::Usage);
+  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, 4, {{2, 0, p, 0}}); }), ErrorKind::Usage);
+  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, 4, {{0, 2, p, 0}}); }), ErrorKind::Usage);
+  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, 4, {{0, 0, p, -1}}); }), ErrorKind::Usage);
+  EXPECT_EQ(kindOf([&] { ScaledConstraintMatrix(2, 2, 4, {{0, 0, p, 4}}); }), ErrorKind::Usage);
+  ScaledConstraintMatrix matrix(2, 2, 4, {{0, 0, p, 0}, {1, 1, p, 3}});
+  EXPECT_EQ(matrix.scaling().scaleCount, 4);
   const std::vector<double> three(3, 1.0), four(4, 2.0);
   EXPECT_EQ(kindOf([&] { matrix.fill(three); }), ErrorKind::Usage);
   EXPECT_DOUBLE_EQ(matrix.fill(four).coeff(1, 5), 1.0);

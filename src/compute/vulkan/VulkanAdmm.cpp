@@ -85,6 +85,9 @@ compute::SparseMatrix unionPatternK0(const compute::SparseMatrix& P, const compu
   return K0;
 }
 
+struct CountPush {  // admm_scaled_values
+  std::uint32_t count;
+};
 struct K1AssemblePush {  // admm_k1_assemble
   std::uint32_t nonZeros;
 };
@@ -230,6 +233,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       k1Values_(context, static_cast<std::size_t>(K0_.nonZeros()), MemoryClass::Device, "ADMM K1 values"),
       k1Assemble_(context, "admm_k1_assemble", 7, sizeof(K1AssemblePush)),
       valuesUpdate_(context),
+      scaledValues_(context, "admm_scaled_values", 4, sizeof(CountPush)),
+      scaledUpdate_(context),
       block_(blockSize(settings.preconditionerBlock, n_)),
       inverseBlocks_(context, static_cast<std::size_t>(n_) * block_, MemoryClass::Device,
                      "ADMM preconditioner blocks"),
@@ -366,6 +371,34 @@ void AdmmKernels::setConstraintValues(const compute::SparseMatrix& C) {
   devC_.values().upload({C_.valuePtr(), static_cast<std::size_t>(C_.nonZeros())});
   valuesUpdate_.run();  // C^T's values
   k1Current_ = false;   // K1 = C^T D C is assembled again at the next setRho
+}
+
+void AdmmKernels::setConstraintScaling(const compute::ConstraintScaling& scaling) {
+  compute::checkConstraintScaling(scaling, C_.nonZeros());
+  const auto entries = static_cast<std::uint32_t>(C_.nonZeros());
+  // Vulkan buffers are never empty: a C without entries keeps one unused element.
+  const std::size_t stored = std::max<std::size_t>(entries, 1);
+  scaledCoefficients_ = std::make_unique<Array<double>>(context_, stored, MemoryClass::Device, "ADMM C coefficients");
+  scaleOf_ = std::make_unique<Array<std::int32_t>>(context_, stored, MemoryClass::Device, "ADMM C scale indices");
+  scales_ = std::make_unique<Array<double>>(context_, std::max<std::size_t>(scaling.scaleCount, 1), MemoryClass::Device,
+                                            "ADMM C scales");
+  if (entries == 0) return;
+  scaledCoefficients_->upload(scaling.coefficients);
+  scaleOf_->upload(scaling.scaleOf);
+  scaledUpdate_.begin();
+  scaledUpdate_.dispatch(scaledValues_, {*scaledCoefficients_, *scaleOf_, *scales_, devC_.values()}, CountPush{entries},
+                         groupsFor(context_, entries));
+  scaledUpdate_.barrier();
+  algebra_.gatherSum(scaledUpdate_, *transpose_, devC_.values(), devCt_.values());
+  scaledUpdate_.end();
+}
+
+void AdmmKernels::setConstraintScales(std::span<const double> scales) {
+  if (!scales_) throwUsage("ADMM: constraint scales given before a constraint scaling");
+  k1Current_ = false;  // K1 = C^T D C is assembled again at the next setRho
+  if (C_.nonZeros() == 0 || scales.empty()) return;
+  scales_->upload(scales);
+  scaledUpdate_.run();
 }
 
 namespace {

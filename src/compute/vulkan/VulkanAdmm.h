@@ -90,6 +90,11 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// follow at the next setRho. Buffers, pipelines, recordings, K's pattern and the
   /// aggregates stay.
   void setConstraintValues(const compute::SparseMatrix& C) override;
+  /// Uploads the coefficients and scale indices once; each setConstraintScales then uploads
+  /// one scale per scale index and forms C's (and C^T's) values on the device
+  /// (shaders/admm_scaled_values.comp). The host copy of C keeps its pattern only.
+  void setConstraintScaling(const compute::ConstraintScaling& scaling) override;
+  void setConstraintScales(std::span<const double> scales) override;
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
   void iterate(int count) override;
@@ -115,7 +120,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   compute::AdmmSettings settings_;
   std::uint32_t n_;
   std::uint32_t m_;
-  compute::SparseMatrix C_;
+  compute::SparseMatrix C_;          ///< Its values may be stale after setConstraintScales.
   compute::SparseMatrix Ct_;
   compute::SparseMatrix K0_;         ///< P + sigma I on the union pattern (host copy).
   std::vector<char> equality_;       ///< Rows of K1's D = equalityRhoScale.
@@ -133,6 +138,12 @@ class AdmmKernels final : public compute::AdmmKernels {
   std::unique_ptr<DeviceGather> transpose_;  ///< C's values -> C^T's.
   Pipeline k1Assemble_;
   Sequence valuesUpdate_;  ///< C^T's values from C's.
+  /// setConstraintScaling's: coefficients, scale indices and the scales of the last step
+  /// per stored entry of C; the sequence forms C's values from them, then C^T's.
+  std::unique_ptr<Array<double>> scaledCoefficients_, scales_;
+  std::unique_ptr<Array<std::int32_t>> scaleOf_;
+  Pipeline scaledValues_;
+  Sequence scaledUpdate_;
   std::uint32_t block_;               ///< Preconditioner block size (AdmmSettings::preconditionerBlock).
   Array<double> inverseBlocks_;      ///< n / block_ inverse diagonal blocks of K, row-major.
   Array<double> rhoRows_;            ///< rho per constraint row.
