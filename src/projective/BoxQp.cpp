@@ -58,11 +58,6 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
   admm_ = backend_.createAdmmSolver(P_, C_, static_cast<const compute::AdmmSettings&>(settings_));
 }
 
-void BoxQpSolver::setConstraintValues(const compute::SparseMatrix& C) {
-  admm_->setConstraintValues(C);
-  C_ = C;
-}
-
 void BoxQpSolver::setConstraintScaling(const compute::ConstraintScaling& scaling) {
   admm_->setConstraintScaling(scaling);
 }

@@ -70,9 +70,6 @@ class BoxQpSolver {
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
-  /// New values of C on the same pattern (compute::AdmmSolver::setConstraintValues): the
-  /// ADMM solver and everything it built for the pattern are kept.
-  void setConstraintValues(const compute::SparseMatrix& C);
   /// C's values as a scaling of its entries from now on (compute::AdmmSolver::
   /// setConstraintScaling), then new values by their scales: the ADMM forms them where it
   /// runs, and C (its values for those scales) serves the polish here.

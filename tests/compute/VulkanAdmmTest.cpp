@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <random>
 
 #include "compute/Admm.h"
@@ -294,6 +295,23 @@ TEST_F(VulkanAdmm, NewConstraintValuesSolveAsAFreshSolverOnBothBackends) {
   EXPECT_THROW(kept->setConstraintValues(compute::SparseMatrix(41, 60)), Error);
 }
 
+/// For each device recording: a kept solver run on `first`, changed by `change`, then run on
+/// `second` solves it as the host's `reference` does (within one check interval of its
+/// iterations, x to 1e-8).
+void expectEveryRecordingSolvesLike(vk::Context& context, const BoxQp& first, const BoxQp& second,
+                                    const compute::AdmmSettings& settings,
+                                    const std::function<void(compute::AdmmSolver&)>& change, const AdmmRun& reference) {
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    auto device = deviceSolver(context, first, settings, recording);
+    runAdmm(*device, first);
+    change(*device);
+    const AdmmRun run = runAdmm(*device, second);
+    EXPECT_LE(std::abs(run.info.iterations - reference.info.iterations), settings.checkInterval);
+    EXPECT_LT(relativeDifference(run.x, reference.x), 1e-8);
+  }
+}
+
 TEST_F(VulkanAdmm, ConstraintScalesGiveTheSolveOfTheirValuesOnBothBackends) {
   // C's values as coefficient / scale per entry (the projective global steps' form): after
   // the scaling is given once, new scales must solve as the values they stand for, given
@@ -328,16 +346,10 @@ TEST_F(VulkanAdmm, ConstraintScalesGiveTheSolveOfTheirValuesOnBothBackends) {
   EXPECT_EQ(host.info.iterations, reference.info.iterations);
   EXPECT_LT(relativeDifference(host.x, reference.x), 1e-12);
 
-  for (const Recording& recording : kRecordings) {
-    SCOPED_TRACE(recording.name);
-    auto device = deviceSolver(context(), first, settings, recording);
-    runAdmm(*device, first);
-    device->setConstraintScaling(scaling);
-    device->setConstraintScales(scales);
-    const AdmmRun run = runAdmm(*device, second);
-    EXPECT_LE(std::abs(run.info.iterations - reference.info.iterations), settings.checkInterval);
-    EXPECT_LT(relativeDifference(run.x, reference.x), 1e-8);
-  }
+  expectEveryRecordingSolvesLike(context(), first, second, settings, [&](compute::AdmmSolver& device) {
+    device.setConstraintScaling(scaling);
+    device.setConstraintScales(scales);
+  }, reference);
 
   EXPECT_THROW(byScales->setConstraintScales(std::vector<double>(16, 1.0)), Error);
   compute::ConstraintScaling fewer = scaling;
@@ -368,15 +380,8 @@ TEST_F(VulkanAdmm, ASetRhoStartsTheNextSolveThereOnBothBackends) {
   EXPECT_EQ(host.info.iterations, fresh.info.iterations);
   EXPECT_LT(relativeDifference(host.x, fresh.x), 1e-12);
 
-  for (const Recording& recording : kRecordings) {
-    SCOPED_TRACE(recording.name);
-    auto device = deviceSolver(context(), qp, settings, recording);
-    runAdmm(*device, qp);
-    device->setRho(rewound);
-    const AdmmRun run = runAdmm(*device, qp);
-    EXPECT_LE(std::abs(run.info.iterations - fresh.info.iterations), settings.checkInterval);
-    EXPECT_LT(relativeDifference(run.x, fresh.x), 1e-8);
-  }
+  expectEveryRecordingSolvesLike(context(), qp, qp, settings, [&](compute::AdmmSolver& device) { device.setRho(rewound); },
+                                 fresh);
 
   for (const double bad : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
     EXPECT_THROW(kept->setRho(bad), Error) << bad;
