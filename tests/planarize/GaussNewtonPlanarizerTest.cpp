@@ -31,7 +31,10 @@ TEST(GaussNewtonPlanarizer, PlanarizesHyparGridWithinThirtyIterations) {
   EXPECT_EQ(info.status, Status::Converged);
   EXPECT_LE(info.iterations, 30);
   EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
-  EXPECT_DOUBLE_EQ(info.maxPlanarity.back(), maxPlanarity(mesh.faces, result));
+  // The solver measures its normalized copy, the check the result in the caller's units:
+  // equal up to the rounding of the normalization.
+  const double measured = maxPlanarity(mesh.faces, result);
+  EXPECT_NEAR(info.maxPlanarity.back(), measured, 1e-12 * measured);
   EXPECT_EQ(info.maxPlanarity.size(), static_cast<std::size_t>(info.iterations) + 1);
 }
 
