@@ -249,6 +249,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
   AdmmMeasures s;
   double rhoBalance = 1.0;
   double linearTolerance = std::numeric_limits<double>::infinity();
+  double primalTolerance = 0.0;
   auto converged = [&]() {
     info.primalResidual = maxOf(s.primalResidual);
     info.dualResidual = maxOf(s.dualResidual);
@@ -263,6 +264,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     const double fraction = settings_.linearToleranceFraction;
     linearTolerance = std::min(linearTolerance, fraction * std::max(std::min(info.primalResidual, info.dualResidual),
                                                                     std::min(epsPrimal, epsDual)));
+    primalTolerance = epsPrimal;
     return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
   };
 
@@ -301,8 +303,18 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     const double change = settings_.stallChange;
     const bool stuck = window.dyMin > 0.0 && window.dyMax <= (1.0 + change) * window.dyMin &&
                        info.primalResidual >= (1.0 - change) * window.primal;
+    // Falling, but too slowly: at this window's rate the primal residual would reach its
+    // tolerance only past the iteration cap, where the attempt would end unconverged all the
+    // same (e.g. a few percent per window at rho's clamp, with ||dy|| shrinking as slowly).
+    bool tooSlow = false;
+    const double before = window.primal;
+    const double now = info.primalResidual;
+    if (now > primalTolerance && now < before) {
+      const double windowsNeeded = std::log(primalTolerance / now) / std::log(now / before);
+      tooSlow = windowsNeeded * (info.iterations - window.begin) > settings_.maxIterations - info.iterations;
+    }
     window = {info.iterations, info.primalResidual, dy, dy};
-    return stuck;
+    return stuck || tooSlow;
   };
 
   s = kernels_->measure();

@@ -53,7 +53,10 @@ struct AdmmSettings {
   /// feasible only by a margin below the tolerances, where OSQP's iteration can neither
   /// converge (that needs dy -> 0) nor certify. Such attempts of the global step's ε
   /// schedule, which moves on from an unconverged attempt either way, ran into the
-  /// iteration cap. The window restarts whenever rho changes.
+  /// iteration cap. Also stop as Stalled when the primal residual fell through the window,
+  /// but at a rate that would reach its tolerance only past maxIterations (an attempt
+  /// creeping a few percent per window at rho's clamp). The window restarts whenever rho
+  /// changes.
   int stallIterations = 200;
   double stallChange = 0.01;
   bool adaptiveRho = true;
@@ -81,7 +84,7 @@ enum class AdmmStatus {
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
-  Stalled,              ///< Not converged and y drifting linearly (AdmmSettings::stallIterations).
+  Stalled,              ///< Not converged, and y drifting linearly or the primal residual too slow to converge within the cap (AdmmSettings::stallIterations).
 };
 
 struct AdmmInfo {

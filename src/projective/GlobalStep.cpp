@@ -194,7 +194,8 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     // iterations with rho still in the problem's range, and the next attempt keeps it.
     // Measured on the CPU, ADMM iterations: hexagonal dome, two Catmull-Clark levels,
     // 102 550 -> 8 060; cube 5 790 -> 5 640 (Catmull-Clark), 7 160 -> 6 690 (four-point);
-    // dodecahedron, four-point, 2 230 -> 5 870 (one attempt then runs to the cap).
+    // dodecahedron, four-point, 2 230 -> 5 870 (one attempt then crept toward the cap, until
+    // attempts too slow to converge within it stopped as stalled too: 2 100).
     if (qpInfo.status == BoxQpStatus::Stalled || qpInfo.status == BoxQpStatus::MaxIterationsReached) {
       qp.setRho(startRho);
     }

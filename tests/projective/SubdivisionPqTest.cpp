@@ -86,6 +86,30 @@ TEST_F(SubdivisionPq, HexagonalDomeTwoCatmullClarkLevelsConvergeWithoutCappedAtt
   }
 }
 
+TEST_F(SubdivisionPq, DodecahedronFourPointAttemptsTooSlowForTheCapStopEarly) {
+  // Level 1's second global step has an attempt whose primal residual falls ~2 % per 200
+  // ADMM iterations at rho's clamp: it ran to the 4000-iteration cap (5 870 ADMM iterations
+  // over both levels). It now stops as stalled once its rate cannot reach the tolerance
+  // within the cap: 2 100, with the same eps per step.
+  PqSubdivisionSettings settings;
+  settings.levels = 2;
+  settings.scheme = SubdivisionScheme::FourPoint;
+  settings.planarityTolerance = 0.5;
+  const PqSubdivisionResult result = subdividePlanarQuads(backend, generate::dodecahedron(), settings);
+  EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+  int admmIterations = 0;
+  for (const PqLevelInfo& level : result.info.levels) {
+    EXPECT_LT(level.planarity.max, 0.05) << "level " << level.level;
+    for (const PqIteration& it : level.iterations) {
+      for (const EpsilonAttempt& attempt : it.attempts) {
+        EXPECT_NE(attempt.status, BoxQpStatus::MaxIterationsReached) << "level " << level.level;
+        admmIterations += attempt.iterations;
+      }
+    }
+  }
+  EXPECT_LT(admmIterations, 3000);
+}
+
 TEST_F(SubdivisionPq, CubeThreeFourPointLevelsEndBelowHalfAPercent) {
   PqSubdivisionSettings settings;
   settings.levels = 3;
