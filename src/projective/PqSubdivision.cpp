@@ -35,7 +35,8 @@ void checkSettings(const PqSubdivisionSettings& settings) {
 /// The local/global iterations of one level (§5 steps 1-4), from the trivially refined
 /// base towards the targets; returns the final positions.
 Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, const Positions& targets,
-                         const PqSubdivisionSettings& settings, PqLevelInfo& info) {
+                         const PqSubdivisionSettings& settings, const PqIterationCallback& callback,
+                         PqLevelInfo& info) {
   const ShapeSpace space(refined);
   GlobalStep global(backend, space, {}, settings.globalStep);
   const double diagonal = boundingBoxDiagonal(targets);
@@ -57,6 +58,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
     record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;
     info.iterations.push_back(record);
+    if (callback) callback(info.level, iteration + 1, info.iterations.back());
     if (record.maxPlanarity <= settings.planarityTolerance && record.maxChange <= settings.changeTolerance) {
       info.converged = true;
       break;
@@ -79,7 +81,7 @@ const char* toString(PqSubdivisionStatus status) {
 }
 
 PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
-                                         const PqSubdivisionSettings& settings) {
+                                         const PqSubdivisionSettings& settings, const PqIterationCallback& callback) {
   checkSettings(settings);
   const auto start = Clock::now();
   PqSubdivisionResult result{SubdivisionHierarchy(base.faces, base.vertexCount(), settings.levels), {base.vertices}, {}};
@@ -103,7 +105,7 @@ PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const Polygo
     Positions fine = linear;
     if (settings.planarize) {
       const PolygonMesh refined{trivialRefinementPositions(refinement, coarseFaces, coarse), refinement.fineFaces};
-      fine = planarizeLevel(backend, refined, linear, settings, levelInfo);
+      fine = planarizeLevel(backend, refined, linear, settings, callback, levelInfo);
       if (!levelInfo.converged) info.status = PqSubdivisionStatus::IterationLimit;
     }
     const double diagonal = boundingBoxDiagonal(linear);

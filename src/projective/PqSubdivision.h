@@ -10,6 +10,7 @@
 // until the max planarity is under the bound and the max vertex change between two
 // iterations (the first compared with the linear targets) is under `changeTolerance`
 // times the bounding-box diagonal. The result of a level is the coarse mesh of the next.
+#include <functional>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -83,14 +84,20 @@ struct PqSubdivisionResult {
   PolygonMesh finestMesh() const { return {positions.back(), hierarchy.faces(hierarchy.finestLevel())}; }
 };
 
+/// Called after every local/global iteration with its level and its number within the
+/// level (both 1-based), for progress output; may be empty.
+using PqIterationCallback = std::function<void(int level, int iteration, const PqIteration&)>;
+
 /// Subdivide `base` settings.levels times.
 ///   backend  in: runs the local fits, planarity and the global step's linear solves.
 ///   base     in: polygon mesh (any face degrees, oriented 2-manifold, with or without
 ///            boundary); ideally planar-faced, since level 1 starts from its trivial
 ///            refinement.
+///   callback in: called after each local/global iteration (may be empty).
 /// Throws Error(Usage) for levels < 0 or non-positive tolerances, Error(BadInput) for a
 /// mesh the refinement rejects, Error(Numerical) when a global step fails.
 PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
-                                         const PqSubdivisionSettings& settings = {});
+                                         const PqSubdivisionSettings& settings = {},
+                                         const PqIterationCallback& callback = {});
 
 }  // namespace plano::projective

@@ -46,6 +46,32 @@ TEST(SubdivisionCommand, WritesThePlanarQuadMeshAndAReportPerLevel) {
   EXPECT_EQ(report["iterations"], iterations);
 }
 
+TEST(SubdivisionCommand, PrintsAProgressLinePerIterationUnlessQuiet) {
+  test::TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const std::string args = "subdivide " + (dir / "cube.obj").string() + " -o " + (dir / "fine.obj").string() +
+                           " --levels 2 --report " + (dir / "report.json").string();
+  const auto loud = test::runTool(args);
+  ASSERT_EQ(loud.exitCode, 0) << loud.err;
+  std::ifstream in(dir / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  for (const auto& level : report["levels"]) {
+    const int n = level["iterations"].get<int>();
+    ASSERT_GE(n, 1);
+    for (int i = 1; i <= n; ++i) {
+      const std::string prefix = "level " + std::to_string(level["level"].get<int>()) + ", iteration " +
+                                 std::to_string(i) + ": max planarity ";
+      EXPECT_NE(loud.err.find(prefix), std::string::npos) << prefix << "\n" << loud.err;
+    }
+    const std::string beyond = "level " + std::to_string(level["level"].get<int>()) + ", iteration " +
+                               std::to_string(n + 1) + ":";
+    EXPECT_EQ(loud.err.find(beyond), std::string::npos) << loud.err;
+  }
+  const auto quiet = test::runTool("-q " + args);
+  ASSERT_EQ(quiet.exitCode, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("iteration"), std::string::npos) << quiet.err;
+}
+
 TEST(SubdivisionCommand, InPlaceLinearFourPointKeepsTheCoarseVertices) {
   test::TempDir dir;
   const PolygonMesh cube = generate::cube();

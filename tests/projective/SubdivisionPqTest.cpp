@@ -110,6 +110,29 @@ TEST_F(SubdivisionPq, DodecahedronFourPointAttemptsTooSlowForTheCapStopEarly) {
   EXPECT_LT(admmIterations, 3000);
 }
 
+TEST_F(SubdivisionPq, TheCallbackSeesEveryIterationOfEveryLevelInOrder) {
+  PqSubdivisionSettings settings;
+  settings.levels = 2;
+  std::vector<std::pair<int, int>> seen;
+  std::vector<double> planarity;
+  const PqSubdivisionResult result = subdividePlanarQuads(
+      backend, generate::cube(1.0), settings, [&](int level, int iteration, const PqIteration& it) {
+        seen.emplace_back(level, iteration);
+        planarity.push_back(it.maxPlanarity);
+      });
+  std::vector<std::pair<int, int>> expected;
+  std::vector<double> recorded;
+  for (const PqLevelInfo& level : result.info.levels) {
+    for (std::size_t i = 0; i < level.iterations.size(); ++i) {
+      expected.emplace_back(level.level, static_cast<int>(i) + 1);
+      recorded.push_back(level.iterations[i].maxPlanarity);
+    }
+  }
+  EXPECT_EQ(seen, expected);
+  EXPECT_EQ(planarity, recorded);
+  EXPECT_EQ(static_cast<int>(seen.size()), result.info.totalIterations);
+}
+
 TEST_F(SubdivisionPq, CubeThreeFourPointLevelsEndBelowHalfAPercent) {
   PqSubdivisionSettings settings;
   settings.levels = 3;

@@ -87,7 +87,16 @@ RunFunction setup(CLI::App& app) {
         options->tolerance > 0.0 ? options->tolerance : (projective::isInterpolating(settings.scheme) ? 0.5 : 0.1);
     settings.maxIterationsPerLevel = options->maxIterations;
     settings.planarize = !options->linear;
-    const projective::PqSubdivisionResult result = projective::subdividePlanarQuads(*backend, input, settings);
+    // One line per local/global iteration: a level of a large mesh runs for minutes.
+    const auto callback = [&](int level, int iteration, const projective::PqIteration& it) {
+      std::ostringstream line;
+      line << std::setprecision(3) << "level " << level << ", iteration " << iteration << ": max planarity "
+           << it.maxPlanarity << "%, change " << it.maxChange << ", eps " << it.epsilon << ", ADMM "
+           << it.admmIterations << " in " << it.attempts.size() << (it.attempts.size() == 1 ? " attempt" : " attempts");
+      progress(global, line.str());
+    };
+    const projective::PqSubdivisionResult result =
+        projective::subdividePlanarQuads(*backend, input, settings, callback);
     const projective::PqSubdivisionInfo& info = result.info;
     const PolygonMesh mesh = result.finestMesh();
 
