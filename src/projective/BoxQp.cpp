@@ -85,7 +85,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   if (info.status == BoxQpStatus::Solved && settings_.polish && info.iterations > 0) {
-    info.polished = polish(q, lower, upper, z, x, y);
+    info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
   }
   info.maxBoundViolation = boundViolation(C_ * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
@@ -93,7 +93,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
 }
 
 bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                         const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+                         const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements) {
   const Eigen::Index n = P_.rows();
   const Eigen::Index m = C_.rows();
   const Eigen::Index k = q.cols();
@@ -168,6 +168,7 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
     for (int it = 0; it < settings_.polishIterations; ++it) {
       const Eigen::MatrixXd rhs = settings_.sigma * xg - qg - CAt * lambda + CAtb;
       solver->solve(rhs, xg);
+      ++refinements;
       const Eigen::MatrixXd r = CA * xg - b;
       lambda += rhoP * r;
       const double residual = infNorm(r);

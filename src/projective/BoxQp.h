@@ -51,6 +51,7 @@ struct BoxQpInfo {
   double maxBoundViolation = 0.0;  ///< max(l - Cx, Cx - u, 0) over all rows and columns.
   double rho = 0.0;              ///< Final rho.
   bool polished = false;         ///< The polished solution was accepted.
+  int polishRefinements = 0;     ///< Method-of-multipliers refinements of the polish (solves; columns sharing an active set share them).
 };
 
 class BoxQpSolver {
@@ -83,7 +84,7 @@ class BoxQpSolver {
 
  private:
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-              const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
+              const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
 
   compute::Backend& backend_;
   BoxQpSettings settings_;

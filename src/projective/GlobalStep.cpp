@@ -183,6 +183,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
       x = xTry;
       info.epsilon = eps;
       info.polished = qpInfo.polished;
+      info.polishRefinements = qpInfo.polishRefinements;
       info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
       solved = true;
       break;

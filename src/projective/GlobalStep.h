@@ -85,6 +85,7 @@ struct GlobalStepInfo {
   int factorizations = 0;
   long linearIterations = 0;         ///< Of the ADMM's solves with K, summed (BoxQpInfo).
   bool polished = false;
+  int polishRefinements = 0;  ///< Of the accepted attempt's polish (BoxQpInfo::polishRefinements).
   Index nonPositiveScales = 0;       ///< Corners with shat <= 0 (reported, not an error).
   std::vector<EpsilonAttempt> attempts;
 };
