@@ -171,6 +171,7 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
   if (!(settings_.stallChange >= 0.0 && settings_.stallChange < 1.0)) {
     throwUsage("ADMM: stallChange must be in [0, 1)");
   }
+  if (std::isnan(settings_.inaccurateDualFactor)) throwUsage("ADMM: inaccurateDualFactor must be a number");
   if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
     throwUsage("ADMM: linearToleranceFraction must be a finite number > 0");
   }
@@ -250,6 +251,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
   double rhoBalance = 1.0;
   double linearTolerance = std::numeric_limits<double>::infinity();
   double primalTolerance = 0.0;
+  double dualTolerance = 0.0;
   auto converged = [&]() {
     info.primalResidual = maxOf(s.primalResidual);
     info.dualResidual = maxOf(s.dualResidual);
@@ -265,6 +267,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     linearTolerance = std::min(linearTolerance, fraction * std::max(std::min(info.primalResidual, info.dualResidual),
                                                                     std::min(epsPrimal, epsDual)));
     primalTolerance = epsPrimal;
+    dualTolerance = epsDual;
     return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
   };
 
@@ -358,6 +361,15 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
         }
       }
     }
+  }
+  // A feasible point whose optimality misses its tolerance by a small factor: on the ε
+  // schedule's small attempts the dual residual often creeps down for thousands of
+  // iterations while the primal one is long converged, and discarding such a point for
+  // the next ε (ten times larger) gave up the step's progress.
+  const bool unconverged = info.status == AdmmStatus::MaxIterationsReached || info.status == AdmmStatus::Stalled;
+  if (unconverged && info.iterations > 0 && settings_.inaccurateDualFactor >= 1.0 &&
+      info.primalResidual <= primalTolerance && info.dualResidual <= settings_.inaccurateDualFactor * dualTolerance) {
+    info.status = AdmmStatus::SolvedInaccurate;
   }
   info.rho = rho_;
   info.linearIterations = s.linearIterations;

@@ -59,6 +59,11 @@ struct AdmmSettings {
   /// changes.
   int stallIterations = 200;
   double stallChange = 0.01;
+  /// An iteration that stops unconverged (the cap, a stall) ends SolvedInaccurate when, at
+  /// its last check, the primal residual met its tolerance and the dual residual this
+  /// many times its own (< 1: never). As OSQP's "solved inaccurate" (10x tolerances), but
+  /// with the primal tolerance kept: the point is feasible, optimal only more loosely.
+  double inaccurateDualFactor = 10.0;
   bool adaptiveRho = true;
   double adaptiveRhoFactor = 5.0;        ///< Change K only when rho moves by more than this factor.
   /// Iterative backends stop each inner solve with K when ||r||_2 <= relativeTolerance
@@ -85,6 +90,7 @@ enum class AdmmStatus {
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
   Stalled,              ///< Not converged, and y drifting linearly or the primal residual too slow to converge within the cap (AdmmSettings::stallIterations).
+  SolvedInaccurate,     ///< Stopped unconverged, but feasible and near optimal (AdmmSettings::inaccurateDualFactor).
 };
 
 struct AdmmInfo {

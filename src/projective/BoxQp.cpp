@@ -18,6 +18,7 @@ BoxQpStatus toBoxQpStatus(compute::AdmmStatus status) {
     case compute::AdmmStatus::MaxIterationsReached: return BoxQpStatus::MaxIterationsReached;
     case compute::AdmmStatus::NonFinite: return BoxQpStatus::NonFinite;
     case compute::AdmmStatus::Stalled: return BoxQpStatus::Stalled;
+    case compute::AdmmStatus::SolvedInaccurate: return BoxQpStatus::SolvedInaccurate;
   }
   return BoxQpStatus::MaxIterationsReached;
 }
@@ -44,6 +45,7 @@ const char* toString(BoxQpStatus status) {
     case BoxQpStatus::MaxIterationsReached: return "max_iterations";
     case BoxQpStatus::NonFinite: return "non_finite";
     case BoxQpStatus::Stalled: return "stalled";
+    case BoxQpStatus::SolvedInaccurate: return "solved_inaccurate";
   }
   return "unknown";
 }
@@ -84,7 +86,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   info.primalResidual = admm.primalResidual;
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
-  if (info.status == BoxQpStatus::Solved && settings_.polish && info.iterations > 0) {
+  if (isSolved(info.status) && settings_.polish && info.iterations > 0) {
     info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
   }
   info.maxBoundViolation = boundViolation(C_ * x, lower, upper);

@@ -37,9 +37,15 @@ enum class BoxQpStatus {
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
   Stalled,              ///< Neither converging nor certifying (compute::AdmmStatus::Stalled).
+  SolvedInaccurate,     ///< Feasible, optimal only to a looser tolerance (compute::AdmmStatus::SolvedInaccurate).
 };
 
 const char* toString(BoxQpStatus status);
+
+/// Solved or SolvedInaccurate: the solution is usable.
+inline bool isSolved(BoxQpStatus status) {
+  return status == BoxQpStatus::Solved || status == BoxQpStatus::SolvedInaccurate;
+}
 
 struct BoxQpInfo {
   BoxQpStatus status = BoxQpStatus::MaxIterationsReached;

@@ -179,7 +179,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     if (qpInfo.status == BoxQpStatus::NonFinite) {
       throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
     }
-    if (qpInfo.status == BoxQpStatus::Solved) {
+    if (isSolved(qpInfo.status)) {
       x = xTry;
       info.epsilon = eps;
       info.polished = qpInfo.polished;

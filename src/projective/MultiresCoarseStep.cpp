@@ -191,7 +191,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     }
     x = xTry;
     y = yTry;  // the next eps starts from this attempt
-    if (qpInfo.status == BoxQpStatus::Solved) {
+    if (isSolved(qpInfo.status)) {
       info.epsilon = eps;
       info.polished = qpInfo.polished;
       info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
