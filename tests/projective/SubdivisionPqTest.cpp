@@ -36,8 +36,30 @@ PolygonMesh perspectiveWarped(PolygonMesh mesh, const Eigen::Vector3d& w) {
   return mesh;
 }
 
+/// Every ε attempt of every global step, in order, with its level.
+std::vector<std::pair<int, EpsilonAttempt>> attemptsOf(const PqSubdivisionResult& result) {
+  std::vector<std::pair<int, EpsilonAttempt>> all;
+  for (const PqLevelInfo& level : result.info.levels) {
+    for (const PqIteration& it : level.iterations) {
+      for (const EpsilonAttempt& attempt : it.attempts) all.emplace_back(level.level, attempt);
+    }
+  }
+  return all;
+}
+
 class SubdivisionPq : public ::testing::Test {
  protected:
+  /// Two levels with the paper's planarity bound for `scheme`, expected to converge.
+  PqSubdivisionResult twoLevels(const PolygonMesh& base, SubdivisionScheme scheme = SubdivisionScheme::CatmullClark) {
+    PqSubdivisionSettings settings;
+    settings.levels = 2;
+    settings.scheme = scheme;
+    settings.planarityTolerance = isInterpolating(scheme) ? 0.5 : 0.1;
+    PqSubdivisionResult result = subdividePlanarQuads(backend, base, settings);
+    EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+    return result;
+  }
+
   compute::CpuBackend backend;
 };
 
@@ -71,18 +93,11 @@ TEST_F(SubdivisionPq, HexagonalDomeTwoCatmullClarkLevelsConvergeWithoutCappedAtt
   // level 2 ran 13 local/global iterations (15 in all, 102 550 ADMM iterations, most
   // attempts to the cap). The next attempt now starts at the stalled one's starting rho:
   // 3 iterations (1 + 2), 8 060 ADMM iterations.
-  PqSubdivisionSettings settings;
-  settings.levels = 2;
-  const PqSubdivisionResult result = subdividePlanarQuads(backend, generate::hexagonalDome(2), settings);
-  EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+  const PqSubdivisionResult result = twoLevels(generate::hexagonalDome(2));
   EXPECT_LE(result.info.totalIterations, 5);
-  for (const PqLevelInfo& level : result.info.levels) {
-    EXPECT_LT(level.planarity.max, 0.1) << "level " << level.level;
-    for (const PqIteration& it : level.iterations) {
-      for (const EpsilonAttempt& attempt : it.attempts) {
-        EXPECT_NE(attempt.status, BoxQpStatus::MaxIterationsReached) << "level " << level.level;
-      }
-    }
+  for (const PqLevelInfo& level : result.info.levels) EXPECT_LT(level.planarity.max, 0.1) << "level " << level.level;
+  for (const auto& [level, attempt] : attemptsOf(result)) {
+    EXPECT_NE(attempt.status, BoxQpStatus::MaxIterationsReached) << "level " << level;
   }
 }
 
@@ -92,19 +107,14 @@ TEST_F(SubdivisionPq, FeasibleNearOptimalAttemptsAreKeptOnAThreeRingDome) {
   // to eps = its initial violation, which the targets themselves satisfy: no progress but
   // the corners' averaging, 18 local/global iterations (80 230 ADMM iterations) to reach
   // 0.0997 %. Kept as solved-inaccurate: 2 iterations, 8 240, max planarity 0.085 % / 0.065 %.
-  PqSubdivisionSettings settings;
-  settings.levels = 2;
-  const PqSubdivisionResult result = subdividePlanarQuads(backend, generate::hexagonalDome(3), settings);
-  EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+  const PqSubdivisionResult result = twoLevels(generate::hexagonalDome(3));
   EXPECT_LE(result.info.totalIterations, 4);
-  int inaccurate = 0;
   for (const PqLevelInfo& level : result.info.levels) {
     EXPECT_LT(level.planarity.max, 0.1) << "level " << level.level;
-    for (const PqIteration& it : level.iterations) {
-      EXPECT_LE(it.constraintResidual, it.epsilon + 1e-6) << "level " << level.level;
-      for (const EpsilonAttempt& attempt : it.attempts) inaccurate += attempt.status == BoxQpStatus::SolvedInaccurate;
-    }
+    for (const PqIteration& it : level.iterations) EXPECT_LE(it.constraintResidual, it.epsilon + 1e-6);
   }
+  int inaccurate = 0;
+  for (const auto& [level, attempt] : attemptsOf(result)) inaccurate += attempt.status == BoxQpStatus::SolvedInaccurate;
   EXPECT_GT(inaccurate, 0);
 }
 
@@ -113,21 +123,12 @@ TEST_F(SubdivisionPq, DodecahedronFourPointAttemptsTooSlowForTheCapStopEarly) {
   // ADMM iterations at rho's clamp: it ran to the 4000-iteration cap (5 870 ADMM iterations
   // over both levels). It now stops as stalled once its rate cannot reach the tolerance
   // within the cap: 2 100, with the same eps per step.
-  PqSubdivisionSettings settings;
-  settings.levels = 2;
-  settings.scheme = SubdivisionScheme::FourPoint;
-  settings.planarityTolerance = 0.5;
-  const PqSubdivisionResult result = subdividePlanarQuads(backend, generate::dodecahedron(), settings);
-  EXPECT_EQ(result.info.status, PqSubdivisionStatus::Converged);
+  const PqSubdivisionResult result = twoLevels(generate::dodecahedron(), SubdivisionScheme::FourPoint);
+  for (const PqLevelInfo& level : result.info.levels) EXPECT_LT(level.planarity.max, 0.05) << "level " << level.level;
   int admmIterations = 0;
-  for (const PqLevelInfo& level : result.info.levels) {
-    EXPECT_LT(level.planarity.max, 0.05) << "level " << level.level;
-    for (const PqIteration& it : level.iterations) {
-      for (const EpsilonAttempt& attempt : it.attempts) {
-        EXPECT_NE(attempt.status, BoxQpStatus::MaxIterationsReached) << "level " << level.level;
-        admmIterations += attempt.iterations;
-      }
-    }
+  for (const auto& [level, attempt] : attemptsOf(result)) {
+    EXPECT_NE(attempt.status, BoxQpStatus::MaxIterationsReached) << "level " << level;
+    admmIterations += attempt.iterations;
   }
   EXPECT_LT(admmIterations, 3000);
 }
