@@ -89,7 +89,9 @@ enum class AdmmStatus {
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).
   MaxIterationsReached, ///< Neither converged nor proven infeasible.
   NonFinite,            ///< NaN or Inf appeared in the iteration.
-  Stalled,              ///< Not converged, and y drifting linearly or the primal residual too slow to converge within the cap (AdmmSettings::stallIterations).
+  /// Not converged, and y drifting linearly or the primal residual falling too slowly to
+  /// converge within the cap (AdmmSettings::stallIterations).
+  Stalled,
   SolvedInaccurate,     ///< Stopped unconverged, but feasible and near optimal (AdmmSettings::inaccurateDualFactor).
 };
 

@@ -11,9 +11,9 @@
 // ratio of the residuals (K changes only when rho moves by more than
 // `adaptiveRhoFactor`). The iteration itself is the backend's (Backend::createAdmmSolver,
 // compute/Admm.h): on the CPU the Eigen loop with a prefactored Cholesky, on Vulkan the
-// whole loop on the device. A converged solution is then polished here, on the host, by
-// re-solving with the active bounds as equalities, which removes the ADMM's residual
-// tolerance from the answer.
+// whole loop on the device. A converged (or solved-inaccurate) solution is then polished
+// here, on the host, by re-solving with the active bounds as equalities, which removes the
+// ADMM's residual tolerance from the answer.
 #include <Eigen/Core>
 #include <memory>
 #include <span>
@@ -57,7 +57,9 @@ struct BoxQpInfo {
   double maxBoundViolation = 0.0;  ///< max(l - Cx, Cx - u, 0) over all rows and columns.
   double rho = 0.0;              ///< Final rho.
   bool polished = false;         ///< The polished solution was accepted.
-  int polishRefinements = 0;     ///< Method-of-multipliers refinements of the polish (solves; columns sharing an active set share them).
+  /// Method-of-multipliers refinements of the polish, one solve each (columns that share
+  /// an active set share them).
+  int polishRefinements = 0;
 };
 
 class BoxQpSolver {
