@@ -59,8 +59,11 @@ TEST_F(NumericalFailureCommand, DeformationAtItsIterationCap) {
                                         "handles": [{"vertex": 48, "position": [1.1, 1.1, 0.4]}]})";
   const auto report = expectNumericalFailure(
       "deform " + path("grid.obj") + " --constraints " + path("c.json") + " --max-iterations 1", "max_iterations");
-  EXPECT_NE(report["reason"].get<std::string>().find("not converged after 1 iterations"), std::string::npos)
-      << report.dump();
+  const std::string reason = report["reason"].get<std::string>();
+  EXPECT_NE(reason.find("not converged after 1 iterations"), std::string::npos) << report.dump();
+  // It names the bound that was missed and its tolerance.
+  EXPECT_NE(reason.find("moved a vertex by"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("of the diagonal (tolerance 0.0001)"), std::string::npos) << reason;
 }
 
 TEST_F(NumericalFailureCommand, PlanarizationThatCannotReachTheTolerance) {

@@ -70,6 +70,20 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
           {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};
 }
 
+/// Which stopping bound the last rigid/similar iteration missed, with its tolerance.
+std::string notConvergedReason(const projective::DeformationInfo& info, const projective::DeformationSettings& settings) {
+  double displacement = 0.0;
+  for (const auto& it : info.history) {
+    if (it.phase == projective::DeformationPhase::Ideal) displacement = it.displacement;
+  }
+  std::ostringstream reason;
+  reason << std::setprecision(3) << "not converged after " << info.iterations
+         << " iterations: the last rigid/similar one moved a vertex by " << displacement
+         << " of the diagonal (tolerance " << settings.tolerance << "), max planarity " << info.planarity.max
+         << "% (tolerance " << settings.planarityTolerance << "%)";
+  return reason.str();
+}
+
 DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& global, compute::Backend& backend,
                              const PolygonMesh& mesh, const PositionalConstraints& constraints) {
   projective::DeformationSettings settings;
@@ -95,8 +109,7 @@ DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& 
   outcome.succeeded = result.info.status == projective::DeformationStatus::Converged;
   outcome.message = result.info.status == projective::DeformationStatus::NumericalFailure
                         ? result.info.message
-                        : "not converged after " + std::to_string(result.info.iterations) +
-                              " iterations (max planarity " + std::to_string(result.info.planarity.max) + "%)";
+                        : notConvergedReason(result.info, settings);
   nlohmann::json epsilons = nlohmann::json::array();
   nlohmann::json residuals = nlohmann::json::array();
   nlohmann::json history = nlohmann::json::array();
