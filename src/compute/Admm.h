@@ -63,6 +63,8 @@ struct AdmmSettings {
   /// its last check, the primal residual met its tolerance and the dual residual this
   /// many times its own (< 1: never). As OSQP's "solved inaccurate" (10x tolerances), but
   /// with the primal tolerance kept: the point is feasible, optimal only more loosely.
+  /// Such an iteration stops at the stall window's check once its dual residual falls too
+  /// slowly to meet its tolerance within the cap, rather than at the cap.
   double inaccurateDualFactor = 10.0;
   bool adaptiveRho = true;
   double adaptiveRhoFactor = 5.0;        ///< Change K only when rho moves by more than this factor.
