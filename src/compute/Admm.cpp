@@ -64,10 +64,7 @@ class HostAdmmKernels final : public AdmmKernels {
   }
 
   void setConstraintScales(std::span<const double> scales) override {
-    double* values = C_.valuePtr();
-    for (std::size_t e = 0; e < scaling_.coefficients.size(); ++e) {
-      values[e] = scaling_.coefficients[e] / scales[static_cast<std::size_t>(scaling_.scaleOf[e])];
-    }
+    fillScaledValues(scaling_, scales, C_.valuePtr());
     Ct_ = C_.transpose();
   }
 
@@ -201,6 +198,12 @@ void checkConstraintScaling(const ConstraintScaling& scaling, Eigen::Index nonZe
   }
 }
 
+void fillScaledValues(const ConstraintScaling& scaling, std::span<const double> scales, double* values) {
+  for (std::size_t e = 0; e < scaling.coefficients.size(); ++e) {
+    values[e] = scaling.coefficients[e] / scales[static_cast<std::size_t>(scaling.scaleOf[e])];
+  }
+}
+
 void AdmmSolver::setConstraintScaling(ConstraintScaling scaling) {
   kernels_->setConstraintScaling(scaling);
   scaleCount_ = scaling.scaleCount;
@@ -286,6 +289,13 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     return false;
   };
 
+  // Feasible, and optimal to within inaccurateDualFactor of the dual tolerance
+  // (AdmmStatus::SolvedInaccurate).
+  auto nearOptimal = [&]() {
+    return settings_.inaccurateDualFactor >= 1.0 && info.primalResidual <= primalTolerance &&
+           info.dualResidual <= settings_.inaccurateDualFactor * dualTolerance;
+  };
+
   // The stall window (AdmmSettings::stallIterations): where it began and the range of
   // ||dy|| seen in it; restarted after a rho change.
   struct StallWindow {
@@ -307,28 +317,23 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     const double change = settings_.stallChange;
     const bool stuck = window.dyMin > 0.0 && window.dyMax <= (1.0 + change) * window.dyMin &&
                        info.primalResidual >= (1.0 - change) * window.primal;
-    // Falling, but too slowly: at this window's rate the primal residual would reach its
-    // tolerance only past the iteration cap, where the attempt would end unconverged all the
-    // same (e.g. a few percent per window at rho's clamp, with ||dy|| shrinking as slowly).
-    bool tooSlow = false;
-    const double before = window.primal;
-    const double now = info.primalResidual;
-    if (now > primalTolerance && now < before) {
-      const double windowsNeeded = std::log(primalTolerance / now) / std::log(now / before);
-      tooSlow = windowsNeeded * (info.iterations - window.begin) > settings_.maxIterations - info.iterations;
-    }
-    // Feasible, the dual residual within inaccurateDualFactor of its tolerance but not
-    // falling fast enough to meet it within the cap: the attempt would at best end
-    // solved-inaccurate at the cap, so it ends here, solved-inaccurate (set after the loop).
-    // On a 3-ring dome's two Catmull-Clark levels: 8 240 -> 5 380 ADMM iterations.
-    bool settledInaccurate = false;
-    if (settings_.inaccurateDualFactor >= 1.0 && info.primalResidual <= primalTolerance &&
-        info.dualResidual > dualTolerance && info.dualResidual <= settings_.inaccurateDualFactor * dualTolerance) {
-      settledInaccurate = !(info.dualResidual < window.dual) ||
-                          std::log(dualTolerance / info.dualResidual) / std::log(info.dualResidual / window.dual) *
-                                  (info.iterations - window.begin) >
-                              settings_.maxIterations - info.iterations;
-    }
+    // Whether a residual that went from `before` to `now` through the window would, at that
+    // rate, reach `tolerance` only past the iteration cap (or not at all).
+    auto tooSlowForTheCap = [&](double before, double now, double tolerance) {
+      if (!(now < before)) return true;
+      const double windowsNeeded = std::log(tolerance / now) / std::log(now / before);
+      return windowsNeeded * (info.iterations - window.begin) > settings_.maxIterations - info.iterations;
+    };
+    // Falling, but too slowly: the attempt would end unconverged at the cap all the same
+    // (e.g. a few percent per window at rho's clamp, with ||dy|| shrinking as slowly).
+    const bool tooSlow = info.primalResidual > primalTolerance && info.primalResidual < window.primal &&
+                         tooSlowForTheCap(window.primal, info.primalResidual, primalTolerance);
+    // Near optimal, the dual residual too slow to meet its own tolerance within the cap: the
+    // attempt would at best end solved-inaccurate at the cap, so it ends here, solved-
+    // inaccurate (set after the loop). On a 3-ring dome's two Catmull-Clark levels: 8 240 ->
+    // 5 380 ADMM iterations.
+    const bool settledInaccurate = info.dualResidual > dualTolerance && nearOptimal() &&
+                                   tooSlowForTheCap(window.dual, info.dualResidual, dualTolerance);
     window = {info.iterations, info.primalResidual, dy, dy, info.dualResidual};
     return stuck || tooSlow || settledInaccurate;
   };
@@ -380,10 +385,7 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
   // iterations while the primal one is long converged, and discarding such a point for
   // the next ε (ten times larger) gave up the step's progress.
   const bool unconverged = info.status == AdmmStatus::MaxIterationsReached || info.status == AdmmStatus::Stalled;
-  if (unconverged && info.iterations > 0 && settings_.inaccurateDualFactor >= 1.0 &&
-      info.primalResidual <= primalTolerance && info.dualResidual <= settings_.inaccurateDualFactor * dualTolerance) {
-    info.status = AdmmStatus::SolvedInaccurate;
-  }
+  if (unconverged && info.iterations > 0 && nearOptimal()) info.status = AdmmStatus::SolvedInaccurate;
   info.rho = rho_;
   info.linearIterations = s.linearIterations;
   info.inexactSolves = s.inexactSolves;

@@ -122,6 +122,10 @@ struct ConstraintScaling {
 /// C with `nonZeros` entries, each index in range.
 void checkConstraintScaling(const ConstraintScaling& scaling, Eigen::Index nonZeros);
 
+/// C's values for these scales (scaling.scaleCount of them, not checked here) into
+/// `values`, one per stored entry, in C's compressed order.
+void fillScaledValues(const ConstraintScaling& scaling, std::span<const double> scales, double* values);
+
 /// Per-column inf-norms at the current iterate (vectors of k entries); all a check needs.
 /// dy = y - y at the start of the last iteration (zero before the first iteration).
 struct AdmmMeasures {

@@ -191,7 +191,8 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
 }
 
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
-                        const ScaledConstraintMatrix& C, std::span<const double> scales, const BoxQpSettings& settings) {
+                        const ScaledConstraintMatrix& C, std::span<const double> scales,
+                        const BoxQpSettings& settings) {
   if (kept) {
     kept->setScaledConstraintValues(C.matrix(), scales);
   } else {

@@ -69,7 +69,8 @@ GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::
     terms.push_back({i, space_.cornerFace(row.cornerA), p, row.cornerA});
     if (row.cornerB >= 0) terms.push_back({i, space_.cornerFace(row.cornerB), -p, row.cornerB});
   }
-  constraints_ = ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), space_.cornerCount(), terms);
+  constraints_ =
+      ScaledConstraintMatrix(static_cast<Index>(rows_.size()), space_.faceCount(), space_.cornerCount(), terms);
 
   // P = I + alpha * (L kron I_4): ||A_f - A_g||^2 per column adds alpha to the (f, f),
   // (g, g) blocks and -alpha to the (f, g), (g, f) blocks of each of the 4 entries.

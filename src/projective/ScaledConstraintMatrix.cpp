@@ -51,10 +51,7 @@ const compute::SparseMatrix& ScaledConstraintMatrix::fill(std::span<const double
     throwUsage("constraint matrix: " + std::to_string(scales.size()) + " scales for terms that use " +
                std::to_string(scaling_.scaleCount));
   }
-  const auto& coefficients = scaling_.coefficients;
-  const auto& scaleOf = scaling_.scaleOf;
-  double* values = C_.valuePtr();
-  for (std::size_t e = 0; e < coefficients.size(); ++e) values[e] = coefficients[e] / scales[scaleOf[e]];
+  compute::fillScaledValues(scaling_, scales, C_.valuePtr());
   return C_;
 }
 

@@ -71,7 +71,8 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
 }
 
 /// Which stopping bound the last rigid/similar iteration missed, with its tolerance.
-std::string notConvergedReason(const projective::DeformationInfo& info, const projective::DeformationSettings& settings) {
+std::string notConvergedReason(const projective::DeformationInfo& info,
+                               const projective::DeformationSettings& settings) {
   double displacement = 0.0;
   for (const auto& it : info.history) {
     if (it.phase == projective::DeformationPhase::Ideal) displacement = it.displacement;
