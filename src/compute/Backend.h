@@ -95,6 +95,12 @@ class Backend {
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;
 
+  /// Whether createSpdSolver's solvers factor A (a solve then costs a pass over the factor
+  /// whatever A's conditioning) rather than iterate (their cost grows with A's condition
+  /// number). Algorithms that can pose a problem either as one stiff system or as a
+  /// sequence of milder ones pick by it (projective/BoxQp.h, EqualitySolve).
+  virtual bool factorsSpdMatrices() const { return false; }
+
   /// An ADMM solver for the box-constrained QPs min 1/2 x'Px + q'x s.t. l <= Cx <= u
   /// (compute/Admm.h), P and C uploaded or kept once. The default runs the iteration on
   /// the host with createSpdSolver's solver; a device backend keeps it on the device.

@@ -76,6 +76,12 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
+                      (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
+  if (direct && lower.size() > 0 && lower == upper) {
+    BoxQpInfo info;
+    if (solveEqualities(q, lower, x, y, info)) return info;
+  }
   Eigen::MatrixXd z;
   const compute::AdmmInfo admm = admm_->solve(q, lower, upper, x, y, z);
   BoxQpInfo info;
@@ -96,7 +102,6 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
 
 bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                          const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements) {
-  const Eigen::Index n = P_.rows();
   const Eigen::Index m = C_.rows();
   const Eigen::Index k = q.cols();
   const double before = boundViolation(C_ * x, lower, upper);
@@ -119,8 +124,12 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
   }
 
   Eigen::MatrixXd xPolished = x;
-  Eigen::MatrixXd yPolished = Eigen::MatrixXd::Zero(m, k);
-  const double rhoP = settings_.polishRho;
+  Eigen::MatrixXd yPolished = y;  // the ADMM duals warm-start the multipliers
+  // A factorization solves for the steps at the same cost, to rounding; solving for the
+  // new points lost ~5e-7 to the rounding of rhoP-sized right-hand sides (measured
+  // against the direct equality solve on a random QP). An iterative solve warm-started at
+  // the ADMM's x solves for the points, cheaply (see solveActiveSet).
+  const Refinement form = backend_.factorsSpdMatrices() ? Refinement::ForSteps : Refinement::ForPoints;
   std::vector<char> done(k, 0);
   for (Eigen::Index first = 0; first < k; ++first) {
     if (done[first]) continue;
@@ -133,61 +142,169 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
         done[c] = 1;
       }
     }
-    const auto g = static_cast<Eigen::Index>(columns.size());
-    std::vector<Eigen::Triplet<double>> entries;
-    for (Eigen::Index i = 0; i < m; ++i) {
-      if (active[first][i]) entries.emplace_back(static_cast<Eigen::Index>(entries.size()), i, 1.0);
-    }
-    compute::SparseMatrix selector(static_cast<Eigen::Index>(entries.size()), m);
-    selector.setFromTriplets(entries.begin(), entries.end());
-    const compute::SparseMatrix CA = selector * C_;
-    const compute::SparseMatrix CAt = CA.transpose();
-    const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
+    const ActiveSetSolve solved = solveActiveSet(active[first], columns, q, targets, form, xPolished, yPolished);
+    refinements += solved.refinements;
     // The stiff polish system can be too ill-conditioned to factor; polishing is an
     // optional refinement, so the ADMM solution stands.
-    std::unique_ptr<compute::SpdSolver> solver;
-    try {
-      solver = backend_.createSpdSolver(K, settings_.linearSolver);
-    } catch (const Error&) {
-      return false;
-    }
-
-    Eigen::MatrixXd qg(n, g), xg(n, g), b(CA.rows(), g), lambda(CA.rows(), g);
-    for (Eigen::Index j = 0; j < g; ++j) {
-      qg.col(j) = q.col(columns[j]);
-      xg.col(j) = x.col(columns[j]);
-      b.col(j) = selector * targets.col(columns[j]);
-      lambda.col(j) = selector * y.col(columns[j]);
-    }
-    // Method of multipliers on the equality-constrained QP, warm-started from the ADMM
-    // duals. Each refinement shrinks the active rows' residual by a factor (~20 on the
-    // cube's and small grids' steps) until rounding (~1e-14) is reached, after which it
-    // only wanders: the refinement stops at the first one that does not shrink it. (The
-    // fixed 30 refinements before spent most of them there.)
-    const Eigen::MatrixXd CAtb = rhoP * (CAt * b);
-    const double goal = 1e-15 * std::max(1.0, infNorm(b));
-    double previous = std::numeric_limits<double>::infinity();
-    for (int it = 0; it < settings_.polishIterations; ++it) {
-      const Eigen::MatrixXd rhs = settings_.sigma * xg - qg - CAt * lambda + CAtb;
-      solver->solve(rhs, xg);
-      ++refinements;
-      const Eigen::MatrixXd r = CA * xg - b;
-      lambda += rhoP * r;
-      const double residual = infNorm(r);
-      if (residual <= goal || residual >= previous) break;
-      previous = residual;
-    }
-    if (!xg.allFinite()) return false;
-    for (Eigen::Index j = 0; j < g; ++j) {
-      xPolished.col(columns[j]) = xg.col(j);
-      yPolished.col(columns[j]) = selector.transpose() * lambda.col(j);
-    }
+    if (!solved.factored) return false;
   }
+  if (!xPolished.allFinite()) return false;
   const double after = boundViolation(C_ * xPolished, lower, upper);
   if (!(after <= std::max(before, 1e-12))) return false;
   x = xPolished;
   y = yPolished;
   return true;
+}
+
+bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixXd& d, Eigen::MatrixXd& x,
+                                  Eigen::MatrixXd& y, BoxQpInfo& info) {
+  const Eigen::Index n = P_.rows();
+  const Eigen::Index m = C_.rows();
+  const Eigen::Index k = q.cols();
+  Eigen::MatrixXd xs = x.size() > 0 ? x : Eigen::MatrixXd::Zero(n, k);
+  Eigen::MatrixXd ys = y.size() > 0 ? y : Eigen::MatrixXd::Zero(m, k);
+
+  // The ADMM's convergence test (compute/Admm.cpp) per column, on x and the multipliers.
+  const auto primalTolerance = [&](const Eigen::MatrixXd& Cx, Eigen::Index c) {
+    return settings_.absoluteTolerance +
+           settings_.relativeTolerance * std::max(Cx.col(c).lpNorm<Eigen::Infinity>(), d.col(c).lpNorm<Eigen::Infinity>());
+  };
+  const auto converged = [&](const Eigen::MatrixXd& xv, const Eigen::MatrixXd& yv, bool checkDual) {
+    const Eigen::MatrixXd Cx = C_ * xv;
+    const Eigen::MatrixXd Px = P_ * xv;
+    const Eigen::MatrixXd Cty = C_.transpose() * yv;
+    info.primalResidual = infNorm(Cx - d);
+    info.dualResidual = infNorm(Px + q + Cty);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      if (!((Cx.col(c) - d.col(c)).lpNorm<Eigen::Infinity>() <= primalTolerance(Cx, c))) return false;
+      const double dualTolerance =
+          settings_.absoluteTolerance +
+          settings_.relativeTolerance * std::max({Px.col(c).lpNorm<Eigen::Infinity>(),
+                                                  Cty.col(c).lpNorm<Eigen::Infinity>(), q.col(c).lpNorm<Eigen::Infinity>()});
+      if (checkDual && !((Px.col(c) + q.col(c) + Cty.col(c)).lpNorm<Eigen::Infinity>() <= dualTolerance)) return false;
+    }
+    return true;
+  };
+
+  info.direct = true;
+  info.rho = admm_->rho();
+  // Warm starts that already solve the problem come back as given, as from the ADMM's
+  // first check.
+  if (converged(xs, ys, true)) {
+    info.status = BoxQpStatus::Solved;
+    info.maxBoundViolation = info.primalResidual;
+    x = xs;
+    y = ys;
+    return true;
+  }
+
+  std::vector<Eigen::Index> columns(static_cast<std::size_t>(k));
+  for (Eigen::Index c = 0; c < k; ++c) columns[static_cast<std::size_t>(c)] = c;
+  const ActiveSetSolve solved = solveActiveSet(std::vector<char>(m, 1), columns, q, d, Refinement::ForSteps, xs, ys);
+  info.polishRefinements = solved.refinements;
+  if (!solved.factored || !solved.solvesConverged || !xs.allFinite() || !ys.allFinite()) return false;
+
+  // The multipliers' stationarity holds to sigma times the last step by construction; the
+  // constraints decide.
+  if (converged(xs, ys, false)) {
+    info.status = BoxQpStatus::Solved;
+    info.maxBoundViolation = info.primalResidual;
+    x = xs;
+    y = ys;
+    return true;
+  }
+  // The residual stopped shrinking above the tolerance. Inconsistent constraints leave the
+  // least-squares residual r = Cx - d, orthogonal to C's range, and the multipliers grow
+  // along it: OSQP's certificate with dy = r (C^T dy ~ 0 and, l = u = d, d^T dy =
+  // -||r||^2 < 0). The warm starts stay as given for the relaxed attempts.
+  const Eigen::MatrixXd r = C_ * xs - d;
+  const Eigen::MatrixXd Ctr = C_.transpose() * r;
+  const double tolerance = settings_.infeasibilityTolerance;
+  for (Eigen::Index c = 0; c < k; ++c) {
+    const double size = r.col(c).lpNorm<Eigen::Infinity>();
+    if (size > primalTolerance(C_ * xs, c) && Ctr.col(c).lpNorm<Eigen::Infinity>() <= tolerance * size &&
+        d.col(c).dot(r.col(c)) < -tolerance * size) {
+      info.status = BoxQpStatus::PrimalInfeasible;
+      info.maxBoundViolation = info.primalResidual;
+      return true;
+    }
+  }
+  return false;
+}
+
+BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>& active,
+                                                        const std::vector<Eigen::Index>& columns,
+                                                        const Eigen::MatrixXd& q, const Eigen::MatrixXd& targets,
+                                                        Refinement form, Eigen::MatrixXd& x,
+                                                        Eigen::MatrixXd& y) const {
+  const Eigen::Index n = P_.rows();
+  const Eigen::Index m = C_.rows();
+  const auto g = static_cast<Eigen::Index>(columns.size());
+  ActiveSetSolve result;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (active[i]) entries.emplace_back(static_cast<Eigen::Index>(entries.size()), i, 1.0);
+  }
+  compute::SparseMatrix selector(static_cast<Eigen::Index>(entries.size()), m);
+  selector.setFromTriplets(entries.begin(), entries.end());
+  const compute::SparseMatrix CA = selector * C_;
+  const compute::SparseMatrix CAt = CA.transpose();
+  const double rhoP = settings_.polishRho;
+  const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
+  std::unique_ptr<compute::SpdSolver> solver;
+  try {
+    solver = backend_.createSpdSolver(K, settings_.linearSolver);
+  } catch (const Error&) {
+    return result;
+  }
+  result.factored = true;
+
+  Eigen::MatrixXd qg(n, g), xg(n, g), b(CA.rows(), g), lambda(CA.rows(), g);
+  for (Eigen::Index j = 0; j < g; ++j) {
+    qg.col(j) = q.col(columns[j]);
+    xg.col(j) = x.col(columns[j]);
+    b.col(j) = selector * targets.col(columns[j]);
+    lambda.col(j) = selector * y.col(columns[j]);
+  }
+  // Each refinement shrinks the active rows' residual by a factor (~20 on the cube's and
+  // small grids' steps) until rounding (~1e-14) is reached, after which it only wanders:
+  // the refinement stops at the first one that does not shrink it. (A fixed 30
+  // refinements spent most of them there.) A refinement solves
+  //   K x' = sigma x - q - C_A^T lambda + rhoP C_A^T b             (for the new point), or
+  //   K dx = -(P x + q + C_A^T lambda) - rhoP C_A^T (C_A x - b)    (for the step),
+  // one x' = x + dx. A factorization gives both alike. An iterative solve's tolerance is
+  // relative to the right-hand side: the first's, dominated by rhoP C_A^T b, leaves errors
+  // far above the solution's (1e-4 of the diagonal from a cold start on a small grid) but
+  // is cheap from a warm start near the solution (the polish's, the ADMM's x); the
+  // second's shrinks as the refinements converge, accurate, but each solve starts cold
+  // (measured on lavapipe: the polish of the 16-face multires deformation's steps 5x
+  // slower). Even a factorization rounds the first form's rhoP-sized values.
+  Eigen::MatrixXd r = CA * xg - b;
+  const Eigen::MatrixXd CAtb = rhoP * (CAt * b);
+  const double goal = 1e-15 * std::max(1.0, infNorm(b));
+  double previous = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < settings_.polishIterations; ++it) {
+    if (form == Refinement::ForSteps) {
+      const Eigen::MatrixXd rhs = -(P_ * xg + qg + CAt * lambda) - rhoP * (CAt * r);
+      Eigen::MatrixXd step = Eigen::MatrixXd::Zero(n, g);
+      if (!solver->solve(rhs, step).converged) result.solvesConverged = false;
+      xg += step;
+    } else {
+      const Eigen::MatrixXd rhs = settings_.sigma * xg - qg - CAt * lambda + CAtb;
+      if (!solver->solve(rhs, xg).converged) result.solvesConverged = false;
+    }
+    ++result.refinements;
+    r = CA * xg - b;
+    lambda += rhoP * r;
+    const double residual = infNorm(r);
+    if (residual <= goal || residual >= previous) break;
+    previous = residual;
+  }
+  for (Eigen::Index j = 0; j < g; ++j) {
+    x.col(columns[j]) = xg.col(j);
+    y.col(columns[j]) = selector.transpose() * lambda.col(j);
+  }
+  return result;
 }
 
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,

@@ -14,9 +14,16 @@
 // whole loop on the device. A converged (or solved-inaccurate) solution is then polished
 // here, on the host, by re-solving with the active bounds as equalities, which removes the
 // ADMM's residual tolerance from the answer.
+//
+// A problem whose rows are all equalities (l = u: the global step's ε = 0 attempts) needs
+// no ADMM at all: the polish's solve with every row active is its exact solution, so it is
+// solved that way directly where the backend factors K (BoxQpSettings::equalitySolve). The ADMM took 30-50
+// iterations there, each a solve with a K whose stiff equality rows made it the global
+// step's dearest part, and ended in that same polish.
 #include <Eigen/Core>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "compute/Admm.h"
 #include "compute/Backend.h"
@@ -24,11 +31,31 @@
 
 namespace plano::projective {
 
+/// How BoxQpSolver solves a problem whose rows are all equalities (l = u).
+enum class EqualitySolve {
+  /// The polish's method of multipliers from the warm starts, no ADMM. Its solution is
+  /// accepted when every column meets the ADMM's primal tolerance; a residual that no
+  /// refinement reduces and that carries OSQP's infeasibility certificate ends
+  /// PrimalInfeasible; anything else (a factorization or inner solve that fails) falls
+  /// back to the ADMM.
+  Direct,
+  Admm,  ///< The ADMM, then the polish, as for any other problem.
+  /// Direct where the backend factors SPD matrices (Backend::factorsSpdMatrices), the ADMM
+  /// on an iterative backend: there the polish's stiff system (rhoP = 1e9) from a cold
+  /// start needs thousands of PCG iterations per solve (measured on lavapipe: a 64-face
+  /// global step 2.7 -> 5.9 s; on 256 faces a solve does not converge within 10 000),
+  /// where the ADMM's milder rho and its face-block or multigrid preconditioned solves do
+  /// better.
+  Automatic,
+};
+
 /// The ADMM's settings (compute::AdmmSettings) and those of the final polish.
 struct BoxQpSettings : compute::AdmmSettings {
   bool polish = true;
   int polishIterations = 30;         ///< Max method-of-multipliers refinements of the polish.
   double polishRho = 1e9;            ///< Penalty of the polish's equality system.
+  /// How an all-equality problem (every row l = u) is solved (EqualitySolve).
+  EqualitySolve equalitySolve = EqualitySolve::Automatic;
 };
 
 enum class BoxQpStatus {
@@ -57,10 +84,17 @@ struct BoxQpInfo {
   double maxBoundViolation = 0.0;  ///< max(l - Cx, Cx - u, 0) over all rows and columns.
   double rho = 0.0;              ///< Final rho.
   bool polished = false;         ///< The polished solution was accepted.
-  /// Method-of-multipliers refinements of the polish, one solve each (columns that share
-  /// an active set share them).
+  /// Solved (or found infeasible) by the direct equality solve, without ADMM iterations
+  /// (EqualitySolve::Direct).
+  bool direct = false;
+  /// Method-of-multipliers refinements of the polish or of the direct equality solve, one
+  /// solve each (columns that share an active set share them).
   int polishRefinements = 0;
 };
+
+/// Whether a solve returned its warm start as the solution: no ADMM iteration and no
+/// refinement of a direct equality solve.
+inline bool startWasOptimal(const BoxQpInfo& info) { return info.iterations == 0 && info.polishRefinements == 0; }
 
 class BoxQpSolver {
  public:
@@ -91,8 +125,29 @@ class BoxQpSolver {
   const BoxQpSettings& settings() const { return settings_; }
 
  private:
+  /// What solveActiveSet did.
+  struct ActiveSetSolve {
+    bool factored = false;         ///< Its matrix could be factored (or set up) at all.
+    bool solvesConverged = true;   ///< Every inner solve reached its tolerance.
+    int refinements = 0;
+  };
+
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
+  /// The direct solve of an all-equality problem (EqualitySolve::Direct) from
+  /// the warm starts; false when it falls back to the ADMM (x and y then untouched).
+  bool solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixXd& d, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                       BoxQpInfo& info);
+  /// Method of multipliers on min 1/2 x'Px + q'x s.t. C_A x = b for `columns`, which
+  /// share the active rows `active` (C_A: those rows of C, b: those rows of `targets`):
+  /// x's and y's columns are the warm starts on entry and the result on exit (y: the
+  /// active rows' multipliers, zero on the others).
+  /// The refinements solve for the new points (warm-started at x: the polish, near the
+  /// solution) or for the steps to them (a cold start: the direct solve); see the .cpp.
+  enum class Refinement { ForPoints, ForSteps };
+  ActiveSetSolve solveActiveSet(const std::vector<char>& active, const std::vector<Eigen::Index>& columns,
+                                const Eigen::MatrixXd& q, const Eigen::MatrixXd& targets, Refinement form,
+                                Eigen::MatrixXd& x, Eigen::MatrixXd& y) const;
 
   compute::Backend& backend_;
   BoxQpSettings settings_;

@@ -173,7 +173,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     Eigen::MatrixXd yTry;
     const double startRho = qp.rho();
     const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
-    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
+    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
     info.linearIterations += qpInfo.linearIterations;
@@ -185,7 +185,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
       info.epsilon = eps;
       info.polished = qpInfo.polished;
       info.polishRefinements = qpInfo.polishRefinements;
-      info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
+      info.status = startWasOptimal(qpInfo) ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
       solved = true;
       break;
     }

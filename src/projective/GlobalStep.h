@@ -65,7 +65,8 @@ struct GlobalStepSettings {
 struct EpsilonAttempt {
   double epsilon = 0.0;
   BoxQpStatus status = BoxQpStatus::MaxIterationsReached;
-  int iterations = 0;
+  int iterations = 0;   ///< ADMM iterations.
+  bool direct = false;  ///< Solved (or found infeasible) by the direct equality solve (BoxQpInfo::direct).
 };
 
 enum class GlobalStepStatus {
@@ -85,7 +86,8 @@ struct GlobalStepInfo {
   int factorizations = 0;
   long linearIterations = 0;         ///< Of the ADMM's solves with K, summed (BoxQpInfo).
   bool polished = false;
-  int polishRefinements = 0;  ///< Of the accepted attempt's polish (BoxQpInfo::polishRefinements).
+  /// Of the accepted attempt's polish or direct equality solve (BoxQpInfo::polishRefinements).
+  int polishRefinements = 0;
   Index nonPositiveScales = 0;       ///< Corners with shat <= 0 (reported, not an error).
   std::vector<EpsilonAttempt> attempts;
 };

@@ -183,7 +183,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     Eigen::MatrixXd xTry = x;
     Eigen::MatrixXd yTry = y;
     const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
-    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations});
+    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
@@ -194,7 +194,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     if (isSolved(qpInfo.status)) {
       info.epsilon = eps;
       info.polished = qpInfo.polished;
-      info.status = qpInfo.iterations == 0 ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
+      info.status = startWasOptimal(qpInfo) ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
       solved = true;
       break;
     }

@@ -513,6 +513,8 @@ struct GlobalStepCase {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     for (Index f = 0; f < space.faceCount(); f += 2) targets[f].topLeftCorner<3, 3>() = R;
     settings.epsilonStart = projective::EpsilonStart::ExactFirst;
+    // Its ε = 0 attempt is the ADMM work compared here; the CPU would solve it directly.
+    settings.qp.equalitySolve = projective::EqualitySolve::Admm;
   }
   PolygonMesh mesh;
   projective::ShapeSpace space;
@@ -719,6 +721,33 @@ TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
     worst = std::max(worst, (deviceMaps.maps[f] - hostMaps.maps[f]).cwiseAbs().maxCoeff());
   }
   EXPECT_LT(worst, 1e-6);  // measured 2e-7 on lavapipe: see the file comment
+}
+
+TEST_F(VulkanAdmm, TheDevicesAdmmGivesTheMapsTheCpuSolvesDirectly) {
+  // EqualitySolve::Automatic: the CPU (CHOLMOD) solves the ε = 0 step directly; the
+  // device, whose PCG the direct solve's stiff system would cost thousands of iterations,
+  // takes the ADMM and polishes. One solution.
+  GlobalStepCase problem(8);
+  problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
+  compute::CpuBackend cpu;
+  projective::GlobalStep hostStep(cpu, problem.space, problem.fixed, problem.settings);
+  projective::GlobalStep deviceStep(backend(), problem.space, problem.fixed, problem.settings);
+  projective::FaceMaps hostMaps, deviceMaps;
+  const projective::GlobalStepInfo hostInfo = hostStep.solve(problem.targets, problem.at, hostMaps);
+  const projective::GlobalStepInfo deviceInfo = deviceStep.solve(problem.targets, problem.at, deviceMaps);
+  ASSERT_EQ(hostInfo.attempts.size(), 1u);
+  ASSERT_EQ(deviceInfo.attempts.size(), 1u);
+  EXPECT_TRUE(hostInfo.attempts[0].direct);
+  EXPECT_EQ(hostInfo.admmIterations, 0);
+  EXPECT_FALSE(deviceInfo.attempts[0].direct);
+  EXPECT_GT(deviceInfo.admmIterations, 0);
+  EXPECT_EQ(deviceInfo.epsilon, 0.0);
+  EXPECT_EQ(hostInfo.epsilon, 0.0);
+  double worst = 0.0;
+  for (std::size_t f = 0; f < hostMaps.maps.size(); ++f) {
+    worst = std::max(worst, (deviceMaps.maps[f] - hostMaps.maps[f]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-6);
 }
 
 TEST_F(VulkanAdmm, AGlobalStepWithoutConstraintRowsKeepsItsTargetsWithoutValidationMessages) {

@@ -153,6 +153,7 @@ TEST_F(GlobalStepTest, ExactFirstGivesExactlyPlanarFacesWhenFeasible) {
   for (std::size_t i = 0; i < fixed.size(); ++i) at.row(i) = mesh.vertices.row(fixed[i]);
   GlobalStepSettings settings;
   settings.epsilonStart = EpsilonStart::ExactFirst;
+  settings.qp.equalitySolve = EqualitySolve::Admm;
   GlobalStep global(backend, space, fixed, settings);
   FaceMaps result;
   const GlobalStepInfo info = global.solve(conflictingTargets(space), at, result);
@@ -160,12 +161,30 @@ TEST_F(GlobalStepTest, ExactFirstGivesExactlyPlanarFacesWhenFeasible) {
   EXPECT_LT(info.constraintResidual, 1e-12);
   EXPECT_LT(maxPlanarity(space.positions(result.maps), mesh.faces), 1e-8);
   EXPECT_GT(maxMapDifference(result.maps, space.identityMaps().maps), 1e-3);  // it did move
+  EXPECT_GT(info.admmIterations, 0);
   // Every row an equality row: the three coordinate columns share their active set, so
   // one polish refinement serves all three, and the residual reaches rounding within a
   // few (the polish ran 30 per column, 90, before it stopped there).
   ASSERT_TRUE(info.polished);
   EXPECT_GE(info.polishRefinements, 1);
   EXPECT_LE(info.polishRefinements, 12);
+
+  // Solved directly (the CPU factors K, so Automatic does): no ADMM iteration, the same
+  // maps to rounding, and as few refinements.
+  settings.qp.equalitySolve = EqualitySolve::Automatic;
+  GlobalStep direct(backend, space, fixed, settings);
+  FaceMaps directResult;
+  const GlobalStepInfo directInfo = direct.solve(conflictingTargets(space), at, directResult);
+  EXPECT_EQ(directInfo.epsilon, 0.0);
+  EXPECT_EQ(directInfo.status, GlobalStepStatus::Solved);
+  EXPECT_EQ(directInfo.admmIterations, 0);
+  ASSERT_EQ(directInfo.attempts.size(), 1u);
+  EXPECT_TRUE(directInfo.attempts[0].direct);
+  EXPECT_FALSE(info.attempts[0].direct);
+  EXPECT_GE(directInfo.polishRefinements, 1);
+  EXPECT_LE(directInfo.polishRefinements, 12);
+  EXPECT_LT(directInfo.constraintResidual, 1e-12);
+  EXPECT_LT(maxMapDifference(directResult.maps, result.maps), 1e-9);
 }
 
 TEST_F(GlobalStepTest, CornerAtInfinityIsANumericalError) {

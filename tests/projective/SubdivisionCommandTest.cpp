@@ -34,7 +34,9 @@ TEST(SubdivisionCommand, WritesThePlanarQuadMeshAndAReportPerLevel) {
       // The ε schedule of each step, ending with the attempt that solved at the step's ε.
       const auto& attempts = step["epsilon_attempts"];
       ASSERT_FALSE(attempts.empty());
-      EXPECT_EQ(attempts.back()["status"], "solved");
+      const std::string status = attempts.back()["status"];
+      EXPECT_TRUE(status == "solved" || status == "solved_inaccurate") << status;
+      EXPECT_EQ(attempts.back()["method"], "admm");  // relaxed attempts (l < u) take the ADMM
       EXPECT_EQ(attempts.back()["epsilon"].get<double>(), step["epsilon"].get<double>());
       int admm = 0;
       for (const auto& attempt : attempts) admm += attempt["iterations"].get<int>();

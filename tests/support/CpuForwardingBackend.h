@@ -22,6 +22,7 @@ class CpuForwardingBackend : public compute::Backend {
                                                       const compute::LinearSolverSettings& settings) override {
     return cpu_.createSpdSolver(A, settings);
   }
+  bool factorsSpdMatrices() const override { return cpu_.factorsSpdMatrices(); }
 
  protected:
   compute::CpuBackend cpu_;

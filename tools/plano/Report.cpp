@@ -17,7 +17,10 @@ nlohmann::json planarityJson(const PlanarityStats& stats) {
 nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>& attempts) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& a : attempts) {
-    list.push_back({{"epsilon", a.epsilon}, {"status", projective::toString(a.status)}, {"iterations", a.iterations}});
+    list.push_back({{"epsilon", a.epsilon},
+                    {"status", projective::toString(a.status)},
+                    {"method", a.direct ? "equality" : "admm"},
+                    {"iterations", a.iterations}});
   }
   return list;
 }

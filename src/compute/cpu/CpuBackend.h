@@ -16,6 +16,7 @@ class CpuBackend final : public Backend {
   void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                         std::span<Eigen::Vector3d> singularValues) override;
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
+  bool factorsSpdMatrices() const override { return true; }  ///< CHOLMOD
 };
 
 }  // namespace plano::compute

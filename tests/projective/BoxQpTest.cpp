@@ -1,0 +1,139 @@
+#include "projective/BoxQp.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+#include "compute/cpu/CpuBackend.h"
+#include "support/CpuForwardingBackend.h"
+
+namespace plano::projective {
+namespace {
+
+/// A random QP with equality rows C x = d that some x0 satisfies: P = I + B B^T / n.
+struct EqualityQp {
+  compute::SparseMatrix P, C;
+  Eigen::MatrixXd q, d;
+};
+
+EqualityQp consistentEqualityQp(Eigen::Index n, Eigen::Index m, Eigen::Index k, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const auto randomMatrix = [&](Eigen::Index rows, Eigen::Index cols) {
+    Eigen::MatrixXd M(rows, cols);
+    for (Eigen::Index i = 0; i < M.size(); ++i) M.data()[i] = uniform(random);
+    return M;
+  };
+  const Eigen::MatrixXd B = randomMatrix(n, n);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd::Identity(n, n) + B * B.transpose() / static_cast<double>(n);
+  EqualityQp qp;
+  qp.P = dense.sparseView();
+  qp.C = randomMatrix(m, n).sparseView();
+  qp.C.makeCompressed();
+  qp.q = randomMatrix(n, k);
+  qp.d = qp.C * randomMatrix(n, k);
+  return qp;
+}
+
+/// The CPU reference, but claiming iterative solves (as the Vulkan backend).
+class IterativeClaimingBackend : public test::CpuForwardingBackend {
+ public:
+  std::string name() const override { return "cpu, claiming iterative solves"; }
+  bool factorsSpdMatrices() const override { return false; }
+};
+
+TEST(BoxQp, AllEqualityProblemIsSolvedDirectlyWithTheAdmmSolution) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 7);
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.equalitySolve = EqualitySolve::Admm;
+  BoxQpSolver admm(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd xAdmm, yAdmm;
+  const BoxQpInfo admmInfo = admm.solve(qp.q, qp.d, qp.d, xAdmm, yAdmm);
+  ASSERT_EQ(admmInfo.status, BoxQpStatus::Solved);
+  EXPECT_GT(admmInfo.iterations, 0);
+  EXPECT_FALSE(admmInfo.direct);
+
+  settings.equalitySolve = EqualitySolve::Direct;
+  BoxQpSolver direct(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = direct.solve(qp.q, qp.d, qp.d, x, y);
+  ASSERT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_TRUE(info.direct);
+  EXPECT_EQ(info.iterations, 0);
+  EXPECT_GE(info.polishRefinements, 1);
+  EXPECT_LE(info.polishRefinements, settings.polishIterations);
+  EXPECT_LT((qp.C * x - qp.d).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((x - xAdmm).cwiseAbs().maxCoeff(), 1e-8);
+  // The multipliers make the point stationary, P x + q + C^T y = 0, to the rounding that
+  // the penalty amplifies in their updates (rhoP = 1e9 times residuals of ~1e-15).
+  EXPECT_LT((qp.P * x + qp.q + qp.C.transpose() * y).cwiseAbs().maxCoeff(), 1e-5);
+}
+
+TEST(BoxQp, AWarmStartThatSolvesTheProblemComesBackWithoutRefinements) {
+  const EqualityQp qp = consistentEqualityQp(10, 4, 2, 11);
+  compute::CpuBackend backend;
+  BoxQpSolver solver(backend, qp.P, qp.C);
+  Eigen::MatrixXd x, y;
+  ASSERT_EQ(solver.solve(qp.q, qp.d, qp.d, x, y).status, BoxQpStatus::Solved);
+  const Eigen::MatrixXd xSolved = x, ySolved = y;
+  const BoxQpInfo again = solver.solve(qp.q, qp.d, qp.d, x, y);
+  EXPECT_EQ(again.status, BoxQpStatus::Solved);
+  EXPECT_TRUE(startWasOptimal(again));
+  EXPECT_EQ(x, xSolved);
+  EXPECT_EQ(y, ySolved);
+}
+
+TEST(BoxQp, InconsistentEqualitiesAreCertifiedInfeasibleWithoutAdmmIterations) {
+  // Rows 0 and 1 ask x0 = 0 and x0 = 1.
+  EqualityQp qp = consistentEqualityQp(6, 3, 1, 3);
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(3, 6);
+  C(0, 0) = 1.0;
+  C(1, 0) = 1.0;
+  C(2, 3) = 1.0;
+  qp.C = C.sparseView();
+  qp.C.makeCompressed();
+  Eigen::MatrixXd d(3, 1);
+  d << 0.0, 1.0, 0.5;
+  compute::CpuBackend backend;
+  BoxQpSolver solver(backend, qp.P, qp.C);
+  const Eigen::MatrixXd xStart = Eigen::MatrixXd::Constant(6, 1, 0.25);
+  Eigen::MatrixXd x = xStart, y;
+  const BoxQpInfo info = solver.solve(qp.q, d, d, x, y);
+  EXPECT_EQ(info.status, BoxQpStatus::PrimalInfeasible);
+  EXPECT_TRUE(info.direct);
+  EXPECT_EQ(info.iterations, 0);
+  EXPECT_LE(info.polishRefinements, BoxQpSettings{}.polishIterations);
+  EXPECT_EQ(x, xStart);  // the warm starts stay for the relaxed attempts
+  EXPECT_EQ(y.size(), 0);
+}
+
+TEST(BoxQp, AutomaticSolvesDirectlyOnlyWhereTheBackendFactors) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 5);
+  IterativeClaimingBackend iterative;
+  BoxQpSolver solver(iterative, qp.P, qp.C);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = solver.solve(qp.q, qp.d, qp.d, x, y);
+  EXPECT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_FALSE(info.direct);
+  EXPECT_GT(info.iterations, 0);
+}
+
+TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 2, 9);
+  Eigen::MatrixXd upper = qp.d;
+  upper.row(2).array() += 0.1;  // one relaxed row
+  BoxQpSettings settings;
+  settings.equalitySolve = EqualitySolve::Direct;
+  compute::CpuBackend backend;
+  BoxQpSolver solver(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = solver.solve(qp.q, qp.d, upper, x, y);
+  EXPECT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_FALSE(info.direct);
+  EXPECT_GT(info.iterations, 0);
+}
+
+}  // namespace
+}  // namespace plano::projective
