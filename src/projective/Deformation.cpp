@@ -60,6 +60,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     it.constraintResidual = step.constraintResidual;
     it.positionalResidual = step.positionalResidual;
     it.admmIterations = step.admmIterations;
+    it.linearIterations = step.linearIterations;
     it.attempts = step.attempts;
     it.displacement = maxRowDistance(next, positions) / diagonal;
     it.maxPlanarity = planarityStats(PolygonMesh{next, space_.faces()}).max;

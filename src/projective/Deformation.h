@@ -59,6 +59,9 @@ struct DeformationIteration {
   double constraintResidual = 0.0;  ///< max |C_s A - d| after the step.
   double positionalResidual = 0.0;
   int admmIterations = 0;
+  /// Of the ADMM's solves with K: one per ADMM iteration on the CPU, PCG iterations on the
+  /// device (GlobalStepInfo::linearIterations).
+  long linearIterations = 0;
   double displacement = 0.0;        ///< Max vertex move this iteration / bounding-box diagonal.
   double maxPlanarity = 0.0;        ///< Percent, after the iteration.
   std::vector<EpsilonAttempt> attempts;  ///< The eps schedule of the global step.

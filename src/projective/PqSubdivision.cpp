@@ -54,6 +54,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.epsilon = step.epsilon;
     record.constraintResidual = step.constraintResidual;
     record.admmIterations = step.admmIterations;
+    record.linearIterations = step.linearIterations;
     record.attempts = step.attempts;
     record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
     record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;

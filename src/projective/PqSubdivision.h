@@ -51,6 +51,7 @@ struct PqIteration {
   double maxChange = 0.0;        ///< Max vertex change relative to the diagonal.
   double constraintResidual = 0.0;  ///< max |C_s A - d| of the global step.
   int admmIterations = 0;
+  long linearIterations = 0;     ///< Of the ADMM's solves with K (GlobalStepInfo::linearIterations).
   std::vector<EpsilonAttempt> attempts;  ///< The global step's ε schedule, in order.
 };
 

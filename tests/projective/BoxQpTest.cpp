@@ -120,6 +120,28 @@ TEST(BoxQp, AutomaticSolvesDirectlyOnlyWhereTheBackendFactors) {
   EXPECT_GT(info.iterations, 0);
 }
 
+TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
+  // A carried rho raised by earlier stiff solves made the device's inner solves stiffer
+  // without saving ADMM iterations: such a solve starts where a fresh solver would.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 13);
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.equalitySolve = EqualitySolve::Admm;
+  BoxQpSolver fresh(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd xFresh, yFresh;
+  const BoxQpInfo freshInfo = fresh.solve(qp.q, qp.d, qp.d, xFresh, yFresh);
+  ASSERT_EQ(freshInfo.status, BoxQpStatus::Solved);
+
+  BoxQpSolver carried(backend, qp.P, qp.C, settings);
+  carried.setRho(1e4);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = carried.solve(qp.q, qp.d, qp.d, x, y);
+  EXPECT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_EQ(info.iterations, freshInfo.iterations);
+  EXPECT_EQ(info.rho, freshInfo.rho);
+  EXPECT_LT((x - xFresh).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 9);
   Eigen::MatrixXd upper = qp.d;

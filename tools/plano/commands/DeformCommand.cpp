@@ -65,6 +65,7 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
           {"constraint_residual", it.constraintResidual},
           {"positional_residual", it.positionalResidual},
           {"admm_iterations", it.admmIterations},
+          {"linear_iterations", it.linearIterations},
           {"displacement", it.displacement},
           {"max_planarity", it.maxPlanarity},
           {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};

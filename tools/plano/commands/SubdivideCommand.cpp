@@ -37,6 +37,7 @@ nlohmann::json levelJson(const projective::PqLevelInfo& level) {
                      {"max_change", it.maxChange},
                      {"constraint_residual", it.constraintResidual},
                      {"admm_iterations", it.admmIterations},
+                     {"linear_iterations", it.linearIterations},
                      {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}});
   }
   return {{"level", level.level},
