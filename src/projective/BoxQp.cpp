@@ -241,7 +241,7 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
                                                         const std::vector<Eigen::Index>& columns,
                                                         const Eigen::MatrixXd& q, const Eigen::MatrixXd& targets,
                                                         Refinement form, Eigen::MatrixXd& x,
-                                                        Eigen::MatrixXd& y) const {
+                                                        Eigen::MatrixXd& y) {
   const Eigen::Index n = P_.rows();
   const Eigen::Index m = C_.rows();
   const auto g = static_cast<Eigen::Index>(columns.size());
@@ -256,12 +256,20 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
   const compute::SparseMatrix CAt = CA.transpose();
   const double rhoP = settings_.polishRho;
   const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
-  std::unique_ptr<compute::SpdSolver> solver;
+  const bool allRows = CA.rows() == m;
+  std::unique_ptr<compute::SpdSolver> created;
+  compute::SpdSolver* solver = nullptr;
   try {
-    solver = backend_.createSpdSolver(K, settings_.linearSolver);
+    if (allRows && allRowsSolver_ && allRowsSolver_->refactor(K)) {
+      solver = allRowsSolver_.get();
+    } else {
+      created = backend_.createSpdSolver(K, settings_.linearSolver);
+      solver = created.get();
+    }
   } catch (const Error&) {
     return result;
   }
+  if (allRows && created) allRowsSolver_ = std::move(created);
   result.factored = true;
 
   Eigen::MatrixXd qg(n, g), xg(n, g), b(CA.rows(), g), lambda(CA.rows(), g);

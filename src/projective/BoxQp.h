@@ -147,13 +147,18 @@ class BoxQpSolver {
   enum class Refinement { ForPoints, ForSteps };
   ActiveSetSolve solveActiveSet(const std::vector<char>& active, const std::vector<Eigen::Index>& columns,
                                 const Eigen::MatrixXd& q, const Eigen::MatrixXd& targets, Refinement form,
-                                Eigen::MatrixXd& x, Eigen::MatrixXd& y) const;
+                                Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
   compute::Backend& backend_;
   BoxQpSettings settings_;
   compute::SparseMatrix P_;
   compute::SparseMatrix C_;
   std::unique_ptr<compute::AdmmSolver> admm_;
+  /// The solver of the system with every row active (each direct equality solve's, an
+  /// all-equality polish's): its pattern is C's, fixed for this object's lifetime, so
+  /// later systems refactor it, keeping what depends on the pattern (CHOLMOD's ordering
+  /// and symbolic analysis).
+  std::unique_ptr<compute::SpdSolver> allRowsSolver_;
 };
 
 /// The solver of a sequence of QPs whose C keeps one sparsity pattern (a loop's global

@@ -142,6 +142,40 @@ TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
   EXPECT_LT((x - xFresh).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+/// The CPU reference, counting the SPD solvers it creates.
+class CountingBackend : public test::CpuForwardingBackend {
+ public:
+  std::string name() const override { return "cpu, counting SPD solvers"; }
+  std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
+                                                      const compute::LinearSolverSettings& settings) override {
+    ++created;
+    return cpu_.createSpdSolver(A, settings);
+  }
+  int created = 0;
+};
+
+TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
+  // Each direct solve's system has C's pattern: the first solver is kept and refactored
+  // (CHOLMOD keeps its ordering and symbolic analysis), with the same solutions.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 17);
+  CountingBackend counting;
+  BoxQpSolver kept(counting, qp.P, qp.C);
+  Eigen::MatrixXd x, y;
+  ASSERT_EQ(kept.solve(qp.q, qp.d, qp.d, x, y).status, BoxQpStatus::Solved);
+  EXPECT_EQ(counting.created, 1);
+  const Eigen::MatrixXd d2 = 2.0 * qp.d;
+  const Eigen::MatrixXd q2 = -qp.q;
+  Eigen::MatrixXd x2, y2;
+  ASSERT_EQ(kept.solve(q2, d2, d2, x2, y2).status, BoxQpStatus::Solved);
+  EXPECT_EQ(counting.created, 1);
+
+  compute::CpuBackend cpu;
+  BoxQpSolver fresh(cpu, qp.P, qp.C);
+  Eigen::MatrixXd xFresh, yFresh;
+  ASSERT_EQ(fresh.solve(q2, d2, d2, xFresh, yFresh).status, BoxQpStatus::Solved);
+  EXPECT_LT((x2 - xFresh).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 9);
   Eigen::MatrixXd upper = qp.d;
