@@ -234,7 +234,7 @@ BENCHMARK_CAPTURE(BM_LocalStep, vulkan, BackendChoice::Vulkan)->Arg(4096)->Arg(6
 // On lavapipe the device global step finishes up to about 1k faces (101 s with the multigrid
 // preconditioner, the default above 64 faces); vulkan_face_blocks is the block-Jacobi baseline.
 BENCHMARK_CAPTURE(BM_GlobalStep, cpu, BackendChoice::Cpu)
-    ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+    ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Arg(262144)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
                   plano::compute::AdmmPreconditioner::BlockJacobi)
     ->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);

@@ -186,6 +186,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
+    info.linearIterations += qpInfo.linearIterations;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
       throwNumerical("coarse global step: the ADMM iteration produced a non-finite value (eps " + number(eps) + ")");
     }
@@ -194,6 +195,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
     if (isSolved(qpInfo.status)) {
       info.epsilon = eps;
       info.polished = qpInfo.polished;
+      info.polishRefinements = qpInfo.polishRefinements;
       info.status = startWasOptimal(qpInfo) ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
       solved = true;
       break;
