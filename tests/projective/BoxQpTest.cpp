@@ -6,6 +6,7 @@
 #include <string>
 
 #include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
 #include "support/CpuForwardingBackend.h"
 
 namespace plano::projective {
@@ -174,6 +175,31 @@ TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
   Eigen::MatrixXd xFresh, yFresh;
   ASSERT_EQ(fresh.solve(q2, d2, d2, xFresh, yFresh).status, BoxQpStatus::Solved);
   EXPECT_LT((x2 - xFresh).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+/// The CPU reference whose first SPD solver (the direct solve's) cannot be factored.
+class FirstFactorizationFailsBackend : public test::CpuForwardingBackend {
+ public:
+  std::string name() const override { return "cpu, first factorization fails"; }
+  std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
+                                                      const compute::LinearSolverSettings& settings) override {
+    if (calls++ == 0) throwNumerical("SPD solver: Cholesky factorization failed (simulated)");
+    return cpu_.createSpdSolver(A, settings);
+  }
+  int calls = 0;
+};
+
+TEST(BoxQp, ADirectSolveThatCannotFactorFallsBackToTheAdmm) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 19);
+  FirstFactorizationFailsBackend failing;
+  BoxQpSolver solver(failing, qp.P, qp.C);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = solver.solve(qp.q, qp.d, qp.d, x, y);
+  EXPECT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_FALSE(info.direct);
+  EXPECT_GT(info.iterations, 0);
+  EXPECT_GE(failing.calls, 2);
+  EXPECT_LT((qp.C * x - qp.d).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
