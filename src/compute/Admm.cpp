@@ -45,7 +45,11 @@ class HostAdmmKernels final : public AdmmKernels {
     const SparseMatrix K = P_ + I * settings_.sigma + SparseMatrix(Ct_ * rho_.asDiagonal() * C_);
     // K's pattern is the same for every rho and every C on one pattern: a factorization
     // keeps its ordering and symbolic analysis.
-    if (!solver_ || !solver_->refactor(K)) solver_ = backend_.createSpdSolver(K, settings_.linearSolver);
+    if (!solver_ || !solver_->refactor(K)) {
+      LinearSolverSettings linear = settings_.linearSolver;
+      linear.measureResidual = false;  // non-finite iterates show in the checks' norms
+      solver_ = backend_.createSpdSolver(K, linear);
+    }
   }
 
   void setConstraintValues(const SparseMatrix& C) override {

@@ -40,6 +40,10 @@ struct ProjectiveFits {
 struct LinearSolverSettings {
   double relativeTolerance = 1e-10;  ///< Iterative solvers stop at ||r|| <= tol * ||b||.
   int maxIterations = 10000;         ///< Iterative solvers only.
+  /// Direct solvers: measure ||A X - B|| / ||B|| for LinearSolveInfo::relativeResidual (a
+  /// product with A per solve, which costs about what the triangular solves do). Loops that
+  /// need only finiteness (the ADMM, the polish: relativeResidual then stays 0) turn it off.
+  bool measureResidual = true;
 };
 
 /// What the last solve did.

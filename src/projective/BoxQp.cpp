@@ -263,7 +263,9 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
     if (allRows && allRowsSolver_ && allRowsSolver_->refactor(K)) {
       solver = allRowsSolver_.get();
     } else {
-      created = backend_.createSpdSolver(K, settings_.linearSolver);
+      compute::LinearSolverSettings linear = settings_.linearSolver;
+      linear.measureResidual = false;  // the refinements check their own constraint residual
+      created = backend_.createSpdSolver(K, linear);
       solver = created.get();
     }
   } catch (const Error&) {

@@ -16,7 +16,7 @@ namespace {
 /// Prefactored sparse Cholesky (supernodal CHOLMOD). Solves are exact up to rounding.
 class CholmodSpdSolver final : public SpdSolver {
  public:
-  explicit CholmodSpdSolver(const SparseMatrix& A) : size_(A.rows()) {
+  CholmodSpdSolver(const SparseMatrix& A, bool measureResidual) : size_(A.rows()), measureResidual_(measureResidual) {
     if (A.rows() != A.cols()) throwNumerical("SPD solver: matrix is not square");
     columnMajor_ = A;
     factor_.compute(columnMajor_);
@@ -32,9 +32,14 @@ class CholmodSpdSolver final : public SpdSolver {
     X = factor_.solve(B);
     LinearSolveInfo info;
     info.iterations = 1;
-    const double bNorm = B.norm();
-    info.relativeResidual = bNorm > 0.0 ? (columnMajor_ * X - B).norm() / bNorm : 0.0;
-    info.converged = factor_.info() == Eigen::Success && std::isfinite(info.relativeResidual);
+    // A non-finite B gives a non-finite X, whose residual relative to a NaN ||B|| would
+    // read 0: finiteness is checked on X itself.
+    info.converged = factor_.info() == Eigen::Success && X.allFinite();
+    if (measureResidual_) {
+      const double bNorm = B.norm();
+      info.relativeResidual = bNorm > 0.0 ? (columnMajor_ * X - B).norm() / bNorm : 0.0;
+      info.converged = info.converged && std::isfinite(info.relativeResidual);
+    }
     return info;
   }
 
@@ -62,6 +67,7 @@ class CholmodSpdSolver final : public SpdSolver {
 
  private:
   Eigen::Index size_;
+  bool measureResidual_;
   Eigen::SparseMatrix<double> columnMajor_;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factor_;
 };
@@ -111,8 +117,8 @@ void CpuBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std
   }
 }
 
-std::unique_ptr<SpdSolver> CpuBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings&) {
-  return std::make_unique<CholmodSpdSolver>(A);
+std::unique_ptr<SpdSolver> CpuBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
+  return std::make_unique<CholmodSpdSolver>(A, settings.measureResidual);
 }
 
 }  // namespace plano::compute
