@@ -44,6 +44,9 @@ struct LinearSolverSettings {
   /// product with A per solve, which costs about what the triangular solves do). Loops that
   /// need only finiteness (the ADMM, the polish: relativeResidual then stays 0) turn it off.
   bool measureResidual = true;
+  /// Iterative solvers: rows per block of the block-Jacobi preconditioner (1 to 4, dividing
+  /// A's size; 1: Jacobi), as AdmmSettings::preconditionerBlock. Direct solvers ignore it.
+  int preconditionerBlock = 1;
 };
 
 /// What the last solve did.

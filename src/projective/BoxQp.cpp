@@ -265,6 +265,7 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
     } else {
       compute::LinearSolverSettings linear = settings_.linearSolver;
       linear.measureResidual = false;  // the refinements check their own constraint residual
+      linear.preconditionerBlock = settings_.preconditionerBlock;  // an iterative backend's
       created = backend_.createSpdSolver(K, linear);
       solver = created.get();
     }

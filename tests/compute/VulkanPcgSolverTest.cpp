@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "compute/GlobalStepMatrices.h"
 #include "compute/MeshMatrices.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
@@ -116,6 +117,50 @@ TEST_F(VulkanPcgSolver, NonPositiveDiagonalIsANumericalErrorNamingTheRow) {
     EXPECT_EQ(e.kind(), ErrorKind::Numerical);
     EXPECT_NE(std::string(e.what()).find("row 1"), std::string::npos) << e.what();
   }
+}
+
+TEST_F(VulkanPcgSolver, FaceBlocksSolveAGlobalStepSystemInFewerIterationsThanJacobi) {
+  // The polish's kind of system: every row of a global step's C active, stiff. Its
+  // 4x4 blocks (one face's map entries) are strongly coupled.
+  const GlobalStepMatrices matrices = globalStepMatrices(6);
+  const compute::SparseMatrix K = matrices.K(1e3);
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(K.rows(), 3);
+  for (Eigen::Index i = 0; i < K.rows(); ++i) B(i, i % 3) = 1.0 + 0.01 * static_cast<double>(i % 7);
+  compute::LinearSolverSettings settings;
+  settings.relativeTolerance = 1e-10;
+  settings.maxIterations = 20000;
+  Eigen::MatrixXd jacobiX = Eigen::MatrixXd::Zero(K.rows(), 3);
+  const auto jacobi = backend().createSpdSolver(K, settings)->solve(B, jacobiX);
+  settings.preconditionerBlock = 4;
+  Eigen::MatrixXd blockX = Eigen::MatrixXd::Zero(K.rows(), 3);
+  const auto blocks = backend().createSpdSolver(K, settings)->solve(B, blockX);
+  ASSERT_TRUE(jacobi.converged);
+  ASSERT_TRUE(blocks.converged);
+  EXPECT_LT(2 * blocks.iterations, jacobi.iterations) << blocks.iterations << " vs " << jacobi.iterations;
+
+  Eigen::MatrixXd reference;
+  compute::CpuBackend().createSpdSolver(K, {})->solve(B, reference);
+  EXPECT_LT((blockX - reference).norm() / reference.norm(), 1e-7);
+  EXPECT_LE((K * blockX - B).norm() / B.norm(), 1.5e-10);
+}
+
+TEST_F(VulkanPcgSolver, ABlockThatIsNotPositiveDefiniteIsANumericalErrorNamingItsRows) {
+  compute::SparseMatrix A(8, 8);
+  for (int i = 0; i < 8; ++i) A.insert(i, i) = 1.0;
+  A.coeffRef(4, 5) = 2.0;  // rows 4..7: [[1, 2], [2, 1]] is indefinite
+  A.coeffRef(5, 4) = 2.0;
+  A.makeCompressed();
+  compute::LinearSolverSettings settings;
+  settings.preconditionerBlock = 4;
+  try {
+    backend().createSpdSolver(A, settings);
+    FAIL() << "expected Error(Numerical)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("rows 4 to 7"), std::string::npos) << e.what();
+  }
+  settings.preconditionerBlock = 3;  // does not divide 8
+  EXPECT_THROW(backend().createSpdSolver(A, settings), Error);
 }
 
 }  // namespace

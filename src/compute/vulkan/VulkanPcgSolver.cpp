@@ -1,7 +1,9 @@
 #include "compute/vulkan/VulkanPcgSolver.h"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "compute/vulkan/PcgPushConstants.h"
 #include "core/Error.h"
@@ -21,15 +23,42 @@ std::uint32_t squareSize(const compute::SparseMatrix& A) {
   return static_cast<std::uint32_t>(A.rows());
 }
 
-std::vector<double> inverseDiagonalOf(const compute::SparseMatrix& A) {
-  std::vector<double> inverse(A.rows());
-  for (Eigen::Index r = 0; r < A.rows(); ++r) {
-    const double d = A.coeff(r, r);
-    if (!(d > 0.0)) {
-      throwNumerical("SPD solver: diagonal entry of row " + std::to_string(r) + " is " + std::to_string(d) +
-                     " (a symmetric positive definite matrix has a positive diagonal)");
+std::uint32_t blockSizeFor(const compute::LinearSolverSettings& settings, std::uint32_t n) {
+  const int b = settings.preconditionerBlock;
+  if (b < 1 || b > 4 || n % static_cast<std::uint32_t>(b) != 0) {
+    throwUsage("SPD solver: preconditioner blocks of " + std::to_string(b) + " rows for " + std::to_string(n) +
+               " rows (need 1 to 4 rows dividing them)");
+  }
+  return static_cast<std::uint32_t>(b);
+}
+
+/// The inverses of A's b x b diagonal blocks, row-major, block after block (b = 1: the
+/// inverse diagonal). Throws Error(Numerical) naming a block that is not positive definite.
+std::vector<double> inverseDiagonalBlocksOf(const compute::SparseMatrix& A, std::uint32_t b) {
+  std::vector<double> inverse(static_cast<std::size_t>(A.rows()) * b);
+  for (Eigen::Index first = 0; first < A.rows(); first += b) {
+    if (b == 1) {
+      const double d = A.coeff(first, first);
+      if (!(d > 0.0)) {
+        throwNumerical("SPD solver: diagonal entry of row " + std::to_string(first) + " is " + std::to_string(d) +
+                       " (a symmetric positive definite matrix has a positive diagonal)");
+      }
+      inverse[static_cast<std::size_t>(first)] = 1.0 / d;
+      continue;
     }
-    inverse[r] = 1.0 / d;
+    Eigen::MatrixXd block(b, b);
+    for (std::uint32_t i = 0; i < b; ++i) {
+      for (std::uint32_t j = 0; j < b; ++j) block(i, j) = A.coeff(first + i, first + j);
+    }
+    const Eigen::LLT<Eigen::MatrixXd> llt(block);
+    if (llt.info() != Eigen::Success || !block.allFinite()) {
+      throwNumerical("SPD solver: the diagonal block of rows " + std::to_string(first) + " to " +
+                     std::to_string(first + b - 1) + " is not positive definite");
+    }
+    const Eigen::MatrixXd blockInverse = llt.solve(Eigen::MatrixXd::Identity(b, b));
+    for (std::uint32_t i = 0; i < b; ++i) {
+      for (std::uint32_t j = 0; j < b; ++j) inverse[static_cast<std::size_t>(first) * b + i * b + j] = blockInverse(i, j);
+    }
   }
   return inverse;
 }
@@ -63,11 +92,12 @@ PcgSolver::PcgSolver(Context& context, const compute::SparseMatrix& A, const com
       n_(squareSize(A)),
       algebra_(context),
       matrix_(context, A),
-      inverseDiagonal_(context, n_, MemoryClass::Device, "inverse diagonal"),
+      block_(blockSizeFor(settings, n_)),
+      inverseBlocks_(context, static_cast<std::size_t>(n_) * block_, MemoryClass::Device, "inverse diagonal blocks"),
       spmvDot_(context, "pcg_spmv_dot", 6, sizeof(PcgSpmvDotPush)),
       step_(context, "pcg_step", 8, sizeof(PcgStepPush)),
       direction_(context, "pcg_direction", 3, sizeof(PcgDirectionPush)) {
-  inverseDiagonal_.upload(inverseDiagonalOf(A));
+  inverseBlocks_.upload(inverseDiagonalBlocksOf(A, block_));
 }
 
 PcgSolver::~PcgSolver() = default;
@@ -88,7 +118,7 @@ void PcgSolver::prepare(std::uint32_t m) {
 
   w.start.begin();
   residual(w.start);
-  la.scaleRows(w.start, inverseDiagonal_, w.r, w.z);
+  la.applyBlockDiagonal(w.start, inverseBlocks_, block_, w.r, w.z);
   la.copy(w.start, w.z, w.p);
   la.dot(w.start, w.r, w.z, w.scalars, kRzEven);
   la.dot(w.start, w.b, w.b, w.scalars, kBb);
@@ -109,9 +139,9 @@ void PcgSolver::prepare(std::uint32_t m) {
     w.block.barrier();
     la.reduce(w.block, w.scalars, kPq);
     w.block.dispatch(step_,
-                     {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseDiagonal_,
+                     {w.p.data(), w.q.data(), w.x.data(), w.r.data(), w.z.data(), inverseBlocks_,
                       w.scalars.values(), w.scalars.partial()},
-                     PcgStepPush{n_, m, current, kPq, 1}, w.scalars.groups(), m);
+                     PcgStepPush{n_, m, current, kPq, block_}, w.scalars.groups(), m);
     w.block.barrier();
     la.reduce(w.block, w.scalars, next);
     w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},

@@ -1,12 +1,15 @@
 #pragma once
-// SPD solves on the device: Jacobi-preconditioned conjugate gradients for several
-// right-hand sides at once (the x, y, z columns of a global step).
+// SPD solves on the device: Jacobi- or block-Jacobi-preconditioned conjugate gradients
+// for several right-hand sides at once (the x, y, z columns of a global step).
 //
 // Why Jacobi: it is one multiply per entry, row-parallel, needs no set-up beyond the
 // diagonal and no triangular solves (incomplete Cholesky's are sequential and slow on
-// GPUs); the global-step matrices (Laplacian-like plus positional weights) are
-// symmetric with positive, fairly uniform diagonals that Jacobi equilibrates. The
-// coordinates decouple, so a block (3x3) Jacobi would have nothing to couple.
+// GPUs); the vertex-based matrices (Laplacian-like plus positional weights) are
+// symmetric with positive, fairly uniform diagonals that Jacobi equilibrates, and their
+// coordinates decouple, so a (3x3) block would have nothing to couple. The projective
+// global step's polish systems couple the four entries of each face's map strongly
+// (through the homogeneous corner coordinates): LinearSolverSettings::preconditionerBlock
+// = 4 inverts those 4x4 blocks (as the device ADMM's inner solve does).
 //
 // The iteration runs in recorded blocks of kCheckInterval iterations: the step lengths
 // (r.z / p.q) stay on the device, and only the m residual norms are read back after each
@@ -21,8 +24,10 @@ class PcgSolver final : public compute::SpdSolver {
  public:
   static constexpr int kCheckInterval = 8;  ///< Iterations per recorded block (even).
 
-  /// Upload A (SPD, compressed) and its inverse diagonal. Throws Error(Numerical) when
-  /// A is not square or a diagonal entry is not positive (naming the row).
+  /// Upload A (SPD, compressed) and the inverses of its diagonal blocks
+  /// (settings.preconditionerBlock rows each). Throws Error(Numerical) when A is not square
+  /// or a diagonal entry (block) is not positive (definite), naming its rows, and
+  /// Error(Usage) for a block size that is not 1 to 4 or does not divide A's size.
   PcgSolver(Context& context, const compute::SparseMatrix& A, const compute::LinearSolverSettings& settings);
   ~PcgSolver() override;
 
@@ -42,7 +47,8 @@ class PcgSolver final : public compute::SpdSolver {
   std::uint32_t n_;
   LinearAlgebra algebra_;
   DeviceCsrMatrix matrix_;
-  Array<double> inverseDiagonal_;
+  std::uint32_t block_;           ///< Preconditioner block size (1: Jacobi).
+  Array<double> inverseBlocks_;  ///< n / block_ inverse diagonal blocks, row-major.
   Pipeline spmvDot_;
   Pipeline step_;
   Pipeline direction_;
