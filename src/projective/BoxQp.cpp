@@ -191,17 +191,18 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
     return true;
   };
 
-  info.direct = true;
-  info.rho = admm_->rho();
-  // Warm starts that already solve the problem come back as given, as from the ADMM's
-  // first check.
-  if (converged(xs, ys, true)) {
+  const auto accept = [&]() {
     info.status = BoxQpStatus::Solved;
     info.maxBoundViolation = info.primalResidual;
     x = xs;
     y = ys;
     return true;
-  }
+  };
+  info.direct = true;
+  info.rho = admm_->rho();
+  // Warm starts that already solve the problem come back as given, as from the ADMM's
+  // first check.
+  if (converged(xs, ys, true)) return accept();
 
   std::vector<Eigen::Index> columns(static_cast<std::size_t>(k));
   for (Eigen::Index c = 0; c < k; ++c) columns[static_cast<std::size_t>(c)] = c;
@@ -211,13 +212,7 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
 
   // The multipliers' stationarity holds to sigma times the last step by construction; the
   // constraints decide.
-  if (converged(xs, ys, false)) {
-    info.status = BoxQpStatus::Solved;
-    info.maxBoundViolation = info.primalResidual;
-    x = xs;
-    y = ys;
-    return true;
-  }
+  if (converged(xs, ys, false)) return accept();
   // The residual stopped shrinking above the tolerance. Inconsistent constraints leave the
   // least-squares residual r = Cx - d, orthogonal to C's range, and the multipliers grow
   // along it: OSQP's certificate with dy = r (C^T dy ~ 0 and, l = u = d, d^T dy =

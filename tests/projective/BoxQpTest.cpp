@@ -143,16 +143,21 @@ TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
   EXPECT_LT((x - xFresh).cwiseAbs().maxCoeff(), 1e-12);
 }
 
-/// The CPU reference, counting the SPD solvers it creates.
+/// The CPU reference, counting the SPD solvers it is asked for; with `failFirst`, the
+/// first one (the direct solve's) cannot be factored.
 class CountingBackend : public test::CpuForwardingBackend {
  public:
+  explicit CountingBackend(bool failFirst = false) : failFirst_(failFirst) {}
   std::string name() const override { return "cpu, counting SPD solvers"; }
   std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
                                                       const compute::LinearSolverSettings& settings) override {
-    ++created;
+    if (created++ == 0 && failFirst_) throwNumerical("SPD solver: Cholesky factorization failed (simulated)");
     return cpu_.createSpdSolver(A, settings);
   }
   int created = 0;
+
+ private:
+  bool failFirst_;
 };
 
 TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
@@ -177,28 +182,16 @@ TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
   EXPECT_LT((x2 - xFresh).cwiseAbs().maxCoeff(), 1e-12);
 }
 
-/// The CPU reference whose first SPD solver (the direct solve's) cannot be factored.
-class FirstFactorizationFailsBackend : public test::CpuForwardingBackend {
- public:
-  std::string name() const override { return "cpu, first factorization fails"; }
-  std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
-                                                      const compute::LinearSolverSettings& settings) override {
-    if (calls++ == 0) throwNumerical("SPD solver: Cholesky factorization failed (simulated)");
-    return cpu_.createSpdSolver(A, settings);
-  }
-  int calls = 0;
-};
-
 TEST(BoxQp, ADirectSolveThatCannotFactorFallsBackToTheAdmm) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 3, 19);
-  FirstFactorizationFailsBackend failing;
+  CountingBackend failing(/*failFirst=*/true);
   BoxQpSolver solver(failing, qp.P, qp.C);
   Eigen::MatrixXd x, y;
   const BoxQpInfo info = solver.solve(qp.q, qp.d, qp.d, x, y);
   EXPECT_EQ(info.status, BoxQpStatus::Solved);
   EXPECT_FALSE(info.direct);
   EXPECT_GT(info.iterations, 0);
-  EXPECT_GE(failing.calls, 2);
+  EXPECT_GE(failing.created, 2);
   EXPECT_LT((qp.C * x - qp.d).cwiseAbs().maxCoeff(), 1e-9);
 }
 
