@@ -170,23 +170,23 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
   Eigen::MatrixXd ys = y.size() > 0 ? y : Eigen::MatrixXd::Zero(m, k);
 
   // The ADMM's convergence test (compute/Admm.cpp) per column, on x and the multipliers.
+  const auto norm = [](const Eigen::MatrixXd& m, Eigen::Index c) { return m.col(c).lpNorm<Eigen::Infinity>(); };
   const auto primalTolerance = [&](const Eigen::MatrixXd& Cx, Eigen::Index c) {
-    return settings_.absoluteTolerance +
-           settings_.relativeTolerance * std::max(Cx.col(c).lpNorm<Eigen::Infinity>(), d.col(c).lpNorm<Eigen::Infinity>());
+    return settings_.absoluteTolerance + settings_.relativeTolerance * std::max(norm(Cx, c), norm(d, c));
   };
   const auto converged = [&](const Eigen::MatrixXd& xv, const Eigen::MatrixXd& yv, bool checkDual) {
     const Eigen::MatrixXd Cx = C_ * xv;
     const Eigen::MatrixXd Px = P_ * xv;
     const Eigen::MatrixXd Cty = C_.transpose() * yv;
-    info.primalResidual = infNorm(Cx - d);
-    info.dualResidual = infNorm(Px + q + Cty);
+    const Eigen::MatrixXd primal = Cx - d;
+    const Eigen::MatrixXd dual = Px + q + Cty;
+    info.primalResidual = infNorm(primal);
+    info.dualResidual = infNorm(dual);
     for (Eigen::Index c = 0; c < k; ++c) {
-      if (!((Cx.col(c) - d.col(c)).lpNorm<Eigen::Infinity>() <= primalTolerance(Cx, c))) return false;
-      const double dualTolerance =
-          settings_.absoluteTolerance +
-          settings_.relativeTolerance * std::max({Px.col(c).lpNorm<Eigen::Infinity>(),
-                                                  Cty.col(c).lpNorm<Eigen::Infinity>(), q.col(c).lpNorm<Eigen::Infinity>()});
-      if (checkDual && !((Px.col(c) + q.col(c) + Cty.col(c)).lpNorm<Eigen::Infinity>() <= dualTolerance)) return false;
+      if (!(norm(primal, c) <= primalTolerance(Cx, c))) return false;
+      const double dualTolerance = settings_.absoluteTolerance +
+                                   settings_.relativeTolerance * std::max({norm(Px, c), norm(Cty, c), norm(q, c)});
+      if (checkDual && !(norm(dual, c) <= dualTolerance)) return false;
     }
     return true;
   };
@@ -217,13 +217,14 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
   // least-squares residual r = Cx - d, orthogonal to C's range, and the multipliers grow
   // along it: OSQP's certificate with dy = r (C^T dy ~ 0 and, l = u = d, d^T dy =
   // -||r||^2 < 0). The warm starts stay as given for the relaxed attempts.
-  const Eigen::MatrixXd r = C_ * xs - d;
+  const Eigen::MatrixXd Cx = C_ * xs;
+  const Eigen::MatrixXd r = Cx - d;
   const Eigen::MatrixXd Ctr = C_.transpose() * r;
   const double tolerance = settings_.infeasibilityTolerance;
   for (Eigen::Index c = 0; c < k; ++c) {
-    const double size = r.col(c).lpNorm<Eigen::Infinity>();
-    if (size > primalTolerance(C_ * xs, c) && Ctr.col(c).lpNorm<Eigen::Infinity>() <= tolerance * size &&
-        d.col(c).dot(r.col(c)) < -tolerance * size) {
+    const double size = norm(r, c);
+    const bool certified = norm(Ctr, c) <= tolerance * size && d.col(c).dot(r.col(c)) < -tolerance * size;
+    if (size > primalTolerance(Cx, c) && certified) {
       info.status = BoxQpStatus::PrimalInfeasible;
       info.maxBoundViolation = info.primalResidual;
       return true;

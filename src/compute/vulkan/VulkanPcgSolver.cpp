@@ -56,8 +56,9 @@ std::vector<double> inverseDiagonalBlocksOf(const compute::SparseMatrix& A, std:
                      std::to_string(first + b - 1) + " is not positive definite");
     }
     const Eigen::MatrixXd blockInverse = llt.solve(Eigen::MatrixXd::Identity(b, b));
+    double* out = inverse.data() + static_cast<std::size_t>(first) * b;
     for (std::uint32_t i = 0; i < b; ++i) {
-      for (std::uint32_t j = 0; j < b; ++j) inverse[static_cast<std::size_t>(first) * b + i * b + j] = blockInverse(i, j);
+      for (std::uint32_t j = 0; j < b; ++j) out[i * b + j] = blockInverse(i, j);
     }
   }
   return inverse;
