@@ -39,6 +39,13 @@ TEST_F(DeformCommand, WritesTheMeshAndAReportWithTheSchedule) {
   EXPECT_EQ(report["residuals"].size(), report["iterations"].get<std::size_t>());
   EXPECT_LT(report["planarity"]["max"].get<double>(), 0.1);
   for (const char* key : {"backend", "vertices", "faces", "seconds"}) EXPECT_TRUE(report.contains(key)) << key;
+  // Every step exact (ε = 0), solved directly on the CPU: no ADMM, and the progress says so.
+  for (const auto& step : report["history"]) {
+    EXPECT_EQ(step["epsilon_attempts"].back()["method"], "equality");
+    EXPECT_EQ(step["admm_iterations"], 0);
+    EXPECT_EQ(step["linear_iterations"], 0);
+  }
+  EXPECT_NE(r.err.find("solved directly"), std::string::npos) << r.err;
 }
 
 TEST_F(DeformCommand, BadConstraintFilesExitWithThree) {

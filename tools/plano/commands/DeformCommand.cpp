@@ -99,8 +99,14 @@ DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& 
     std::ostringstream line;
     line << std::setprecision(3) << "iteration " << it.iteration
          << (it.phase == projective::DeformationPhase::Ideal ? "" : " (projection)") << ": displacement "
-         << it.displacement << ", eps " << it.epsilon << ", constraint residual " << it.constraintResidual
-         << ", ADMM " << it.admmIterations << ", max planarity " << it.maxPlanarity << "%";
+         << it.displacement << ", eps " << it.epsilon << ", constraint residual " << it.constraintResidual;
+    // An exact step that the backend solved without ADMM (projective/BoxQp.h) says so.
+    if (!it.attempts.empty() && it.attempts.back().direct) {
+      line << ", solved directly";
+    } else {
+      line << ", ADMM " << it.admmIterations;
+    }
+    line << ", max planarity " << it.maxPlanarity << "%";
     progress(global, line.str());
   };
   const projective::DeformationResult result = projective::deform(backend, mesh, constraints, settings, callback);
