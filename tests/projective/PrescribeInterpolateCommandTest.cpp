@@ -63,7 +63,10 @@ TEST_F(PrescribeInterpolateCommands, InterpolateReturnsTheEndpointsAndPlanarMesh
     if (t == 1.0) {
       EXPECT_LT(test::maxAbsDifference(out.vertices, b.vertices), 1e-6);
     }
-    EXPECT_LT(report("i.json")["planarity"]["max"].get<double>(), 1e-3) << "t = " << t;
+    const auto j = report("i.json");
+    EXPECT_LT(j["planarity"]["max"].get<double>(), 1e-3) << "t = " << t;
+    ASSERT_FALSE(j["epsilon_attempts"].empty()) << "t = " << t;
+    for (const auto& attempt : j["epsilon_attempts"]) EXPECT_TRUE(attempt.contains("method")) << "t = " << t;
   }
   EXPECT_EQ(test::runTool("interpolate " + path("grid.obj") + " missing.obj --t 0.5 -o " + path("i.obj")).exitCode, 3);
 }

@@ -44,7 +44,8 @@ RunFunction setup(CLI::App& app) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json report = baseReport("interpolate", backend->name(), result, stats, seconds);
     report["t"] = options->t;
-    report["iterations"] = info.admmIterations;
+    report["iterations"] = info.admmIterations;  // ADMM iterations (0 when solved directly)
+    report["epsilon_attempts"] = epsilonAttemptsJson(info.attempts);
     report["epsilon"] = info.epsilon;
     report["initial_violation"] = info.initialViolation;
     report["constraint_residual"] = info.constraintResidual;

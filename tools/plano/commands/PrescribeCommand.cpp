@@ -40,7 +40,9 @@ nlohmann::json stepJson(const projective::GlobalStepInfo& info) {
           {"initial_violation", info.initialViolation},
           {"constraint_residual", info.constraintResidual},
           {"positional_residual", info.positionalResidual},
-          {"admm_iterations", info.admmIterations}};
+          {"admm_iterations", info.admmIterations},
+          {"linear_iterations", info.linearIterations},
+          {"epsilon_attempts", epsilonAttemptsJson(info.attempts)}};
 }
 
 RunFunction setup(CLI::App& app) {
