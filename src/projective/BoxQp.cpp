@@ -208,6 +208,7 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
   for (Eigen::Index c = 0; c < k; ++c) columns[static_cast<std::size_t>(c)] = c;
   const ActiveSetSolve solved = solveActiveSet(std::vector<char>(m, 1), columns, q, d, Refinement::ForSteps, xs, ys);
   info.polishRefinements = solved.refinements;
+  info.factorizations = solved.factored ? 1 : 0;
   if (!solved.factored || !solved.solvesConverged || !xs.allFinite() || !ys.allFinite()) return false;
 
   // The multipliers' stationarity holds to sigma times the last step by construction; the

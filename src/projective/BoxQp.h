@@ -78,7 +78,7 @@ inline bool isSolved(BoxQpStatus status) {
 struct BoxQpInfo {
   BoxQpStatus status = BoxQpStatus::MaxIterationsReached;
   int iterations = 0;            ///< ADMM iterations.
-  int factorizations = 0;        ///< Factorizations of K (1 + rho updates).
+  int factorizations = 0;        ///< Factorizations of K (1 + rho updates; a direct solve's: 1).
   long linearIterations = 0;     ///< Of the ADMM's solves with K (1 per direct solve, PCG iterations on the device).
   double primalResidual = 0.0;   ///< ||C x - z||_inf (max over columns), after polishing.
   double dualResidual = 0.0;     ///< ||P x + q + C^T y||_inf before polishing.

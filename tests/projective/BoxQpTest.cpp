@@ -63,6 +63,7 @@ TEST(BoxQp, AllEqualityProblemIsSolvedDirectlyWithTheAdmmSolution) {
   ASSERT_EQ(info.status, BoxQpStatus::Solved);
   EXPECT_TRUE(info.direct);
   EXPECT_EQ(info.iterations, 0);
+  EXPECT_EQ(info.factorizations, 1);
   EXPECT_GE(info.polishRefinements, 1);
   EXPECT_LE(info.polishRefinements, settings.polishIterations);
   EXPECT_LT((qp.C * x - qp.d).cwiseAbs().maxCoeff(), 1e-10);
