@@ -269,7 +269,9 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
   } catch (const Error&) {
     return result;
   }
-  if (allRows && created) allRowsSolver_ = std::move(created);
+  // Only a factorization has something to keep (its analysis, reused by refactor); an
+  // iterative backend's solver would hold its copy of K on the device between steps.
+  if (allRows && created && backend_.factorsSpdMatrices()) allRowsSolver_ = std::move(created);
   result.factored = true;
 
   Eigen::MatrixXd qg(n, g), xg(n, g), b(CA.rows(), g), lambda(CA.rows(), g);
