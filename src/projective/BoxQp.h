@@ -156,9 +156,9 @@ class BoxQpSolver {
   compute::SparseMatrix C_;
   std::unique_ptr<compute::AdmmSolver> admm_;
   /// The solver of the system with every row active (each direct equality solve's, an
-  /// all-equality polish's): its pattern is C's, fixed for this object's lifetime, so
-  /// later systems refactor it, keeping what depends on the pattern (CHOLMOD's ordering
-  /// and symbolic analysis).
+  /// all-equality polish's) where the backend factors: its pattern is C's, fixed for this
+  /// object's lifetime, so later systems refactor it, keeping what depends on the pattern
+  /// (CHOLMOD's ordering and symbolic analysis).
   std::unique_ptr<compute::SpdSolver> allRowsSolver_;
 };
 
