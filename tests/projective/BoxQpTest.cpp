@@ -44,22 +44,27 @@ class IterativeClaimingBackend : public test::CpuForwardingBackend {
   bool factorsSpdMatrices() const override { return false; }
 };
 
+/// qp's equalities (l = u = d) on a new solver of `backend`.
+BoxQpInfo solveOnNewSolver(compute::Backend& backend, const EqualityQp& qp, const BoxQpSettings& settings,
+                           Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  BoxQpSolver solver(backend, qp.P, qp.C, settings);
+  return solver.solve(qp.q, qp.d, qp.d, x, y);
+}
+
 TEST(BoxQp, AllEqualityProblemIsSolvedDirectlyWithTheAdmmSolution) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 3, 7);
   compute::CpuBackend backend;
   BoxQpSettings settings;
   settings.equalitySolve = EqualitySolve::Admm;
-  BoxQpSolver admm(backend, qp.P, qp.C, settings);
   Eigen::MatrixXd xAdmm, yAdmm;
-  const BoxQpInfo admmInfo = admm.solve(qp.q, qp.d, qp.d, xAdmm, yAdmm);
+  const BoxQpInfo admmInfo = solveOnNewSolver(backend, qp, settings, xAdmm, yAdmm);
   ASSERT_EQ(admmInfo.status, BoxQpStatus::Solved);
   EXPECT_GT(admmInfo.iterations, 0);
   EXPECT_FALSE(admmInfo.direct);
 
   settings.equalitySolve = EqualitySolve::Direct;
-  BoxQpSolver direct(backend, qp.P, qp.C, settings);
   Eigen::MatrixXd x, y;
-  const BoxQpInfo info = direct.solve(qp.q, qp.d, qp.d, x, y);
+  const BoxQpInfo info = solveOnNewSolver(backend, qp, settings, x, y);
   ASSERT_EQ(info.status, BoxQpStatus::Solved);
   EXPECT_TRUE(info.direct);
   EXPECT_EQ(info.iterations, 0);
@@ -114,9 +119,8 @@ TEST(BoxQp, InconsistentEqualitiesAreCertifiedInfeasibleWithoutAdmmIterations) {
 TEST(BoxQp, AutomaticSolvesDirectlyOnlyWhereTheBackendFactors) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 3, 5);
   IterativeClaimingBackend iterative;
-  BoxQpSolver solver(iterative, qp.P, qp.C);
   Eigen::MatrixXd x, y;
-  const BoxQpInfo info = solver.solve(qp.q, qp.d, qp.d, x, y);
+  const BoxQpInfo info = solveOnNewSolver(iterative, qp, {}, x, y);
   EXPECT_EQ(info.status, BoxQpStatus::Solved);
   EXPECT_FALSE(info.direct);
   EXPECT_GT(info.iterations, 0);
@@ -129,9 +133,8 @@ TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
   compute::CpuBackend backend;
   BoxQpSettings settings;
   settings.equalitySolve = EqualitySolve::Admm;
-  BoxQpSolver fresh(backend, qp.P, qp.C, settings);
   Eigen::MatrixXd xFresh, yFresh;
-  const BoxQpInfo freshInfo = fresh.solve(qp.q, qp.d, qp.d, xFresh, yFresh);
+  const BoxQpInfo freshInfo = solveOnNewSolver(backend, qp, settings, xFresh, yFresh);
   ASSERT_EQ(freshInfo.status, BoxQpStatus::Solved);
 
   BoxQpSolver carried(backend, qp.P, qp.C, settings);
@@ -186,9 +189,8 @@ TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
 TEST(BoxQp, ADirectSolveThatCannotFactorFallsBackToTheAdmm) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 3, 19);
   CountingBackend failing(/*failFirst=*/true);
-  BoxQpSolver solver(failing, qp.P, qp.C);
   Eigen::MatrixXd x, y;
-  const BoxQpInfo info = solver.solve(qp.q, qp.d, qp.d, x, y);
+  const BoxQpInfo info = solveOnNewSolver(failing, qp, {}, x, y);
   EXPECT_EQ(info.status, BoxQpStatus::Solved);
   EXPECT_FALSE(info.direct);
   EXPECT_GT(info.iterations, 0);
