@@ -3,7 +3,10 @@
 // the peak resident set over the run: Linux's VmHWM, reset at the start through
 // /proc/self/clear_refs) and, on the Vulkan backend, the peak of the device allocations
 // the backend made during the run. Both in MiB; a counter that cannot be measured is left
-// out rather than reported as zero.
+// out rather than reported as zero. On Vulkan also the host <-> device copies per iteration
+// of the benchmark loop (`uploaded_KiB`, `downloaded_KiB`, and `transfers`, their number:
+// each one a synchronisation with the device), what a loop meant to stay on the device
+// still moves; counted from construction or from markLoopStart().
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -36,7 +39,15 @@ class MemoryCounters {
     clear << "5";  // resets VmHWM to the current resident set
     clear.close();
     if (clear) startKiB_ = procStatusKiB("VmRSS");
-    if (vulkan_) vulkan_->context().resetPeakAllocatedBytes();
+    if (vulkan_) {
+      vulkan_->context().resetPeakAllocatedBytes();
+      transfersBefore_ = vulkan_->context().transfers();
+    }
+  }
+  /// Count transfers from here on: call right before the benchmark loop when the set-up
+  /// uploads (a solver's matrices) should not be averaged into the loop's figures.
+  void markLoopStart() {
+    if (vulkan_) transfersBefore_ = vulkan_->context().transfers();
   }
   ~MemoryCounters() {
     const std::optional<double> peakKiB = procStatusKiB("VmHWM");
@@ -44,6 +55,17 @@ class MemoryCounters {
     if (startKiB_ && peakKiB) state_.counters["host_peak_MiB"] = std::max(0.0, *peakKiB - *startKiB_) / 1024.0;
     if (vulkan_) {
       state_.counters["device_peak_MiB"] = static_cast<double>(vulkan_->context().peakAllocatedBytes()) / (1 << 20);
+      const vk::TransferCounts after = vulkan_->context().transfers();
+      const auto perIteration = [](double value) {
+        return benchmark::Counter(value, benchmark::Counter::kAvgIterations);
+      };
+      state_.counters["uploaded_KiB"] =
+          perIteration(static_cast<double>(after.uploadedBytes - transfersBefore_.uploadedBytes) / 1024.0);
+      state_.counters["downloaded_KiB"] =
+          perIteration(static_cast<double>(after.downloadedBytes - transfersBefore_.downloadedBytes) / 1024.0);
+      state_.counters["transfers"] = perIteration(static_cast<double>(after.uploads + after.downloads -
+                                                                      transfersBefore_.uploads -
+                                                                      transfersBefore_.downloads));
     }
   }
   MemoryCounters(const MemoryCounters&) = delete;
@@ -53,6 +75,7 @@ class MemoryCounters {
   benchmark::State& state_;
   compute::VulkanBackend* vulkan_;
   std::optional<double> startKiB_;
+  vk::TransferCounts transfersBefore_;
 };
 
 }  // namespace plano::bench

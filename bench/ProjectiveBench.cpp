@@ -47,10 +47,11 @@ plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
 void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
-  const plano::bench::MemoryCounters memory(state, backend);
+  plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const plano::projective::ShapeSpace space(mesh);
   const plano::Positions target = perspectiveTarget(space);
+  memory.markLoopStart();
   for (auto _ : state) {
     auto result = plano::projective::fitFaceMaps(*backend, space, target);
     benchmark::DoNotOptimize(result.fits.maps.data());
@@ -64,7 +65,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
                    plano::compute::AdmmPreconditioner preconditioner = plano::compute::AdmmPreconditioner::Automatic) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
-  const plano::bench::MemoryCounters memory(state, backend);
+  plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const plano::projective::ShapeSpace space(mesh);
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
@@ -81,6 +82,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   plano::projective::GlobalStep global(*backend, space, fixed, settings);
   plano::projective::FaceMaps result;
   plano::projective::GlobalStepInfo info;
+  memory.markLoopStart();
   for (auto _ : state) {
     info = global.solve(targets, at, result);
     benchmark::DoNotOptimize(result.maps.data());
@@ -95,7 +97,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
 void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
-  const plano::bench::MemoryCounters memory(state, backend);
+  plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = grid(state);
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
   plano::PositionalConstraints constraints;
@@ -109,6 +111,7 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
   plano::Positions handles(1, 3);
   handles.row(0) = constraints.handles[0].position.transpose();
   int admm = 0;
+  memory.markLoopStart();
   for (auto _ : state) {
     plano::Positions positions = mesh.vertices;
     const auto info = deformation.solve(handles, positions);

@@ -3,6 +3,7 @@
 // direct deformation at the Yas Island scale of the paper's Table 1.
 #include <benchmark/benchmark.h>
 
+#include "MemoryCounters.h"
 #include "VulkanBenchSupport.h"
 #include "compute/Backend.h"
 #include "mesh/Generators.h"
@@ -56,6 +57,7 @@ namespace {
 void BM_PqSubdivision(benchmark::State& state, bool cube, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh base = cube ? plano::generate::cube() : plano::generate::translationalSurface(32, 32);
   plano::projective::PqSubdivisionSettings settings;
   settings.levels = static_cast<int>(state.range(0));

@@ -73,7 +73,7 @@ void BM_Eigenshapes(benchmark::State& state, SpaceKind kind) {
 void BM_SubspaceDeformationIteration(benchmark::State& state, SpaceKind kind, compute::BackendChoice choice) {
   compute::Backend* backend = bench::backendOrSkip(state, choice);
   if (!backend) return;
-  const bench::MemoryCounters memory(state, backend);
+  bench::MemoryCounters memory(state, backend);
   const PolygonMesh mesh = gridOfFaces(state.range(0));
   const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(kind, mesh.faceCount()));
   const Index side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
@@ -93,6 +93,7 @@ void BM_SubspaceDeformationIteration(benchmark::State& state, SpaceKind kind, co
     return;
   }
   std::int64_t iterations = 0;
+  memory.markLoopStart();
   for (auto _ : state) {
     X = mesh.vertices;
     iterations += deformer.solve(X).iterations;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <span>
+#include <vector>
 
 #include "compute/vulkan/VulkanBuffer.h"
 #include "compute/vulkan/VulkanContext.h"
@@ -68,6 +70,26 @@ TEST(VulkanContext, ImpossibleAllocationIsADeviceErrorNamingTheBuffer) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Device);
     EXPECT_NE(std::string(e.what()).find("a 4 TiB test buffer"), std::string::npos) << e.what();
+  }
+}
+
+TEST(VulkanContext, CountsEachCopyBetweenHostAndDeviceOnceWhetherMappedOrStaged) {
+  for (const bool staged : {false, true}) {
+    vk::ContextSettings settings = validatedSettings();
+    settings.forceStaging = staged;
+    vk::Context context(settings);
+    vk::Array<double> values(context, 100, vk::MemoryClass::Device, "test values");
+    std::vector<double> host(100, 1.5);
+    values.upload(host);
+    values.upload(std::span<const double>(host).first(10), 90);
+    values.download(std::span<double>(host).first(25));
+    const vk::TransferCounts counts = context.transfers();
+    EXPECT_EQ(counts.uploads, 2u) << "staged " << staged;
+    EXPECT_EQ(counts.uploadedBytes, 110u * sizeof(double)) << "staged " << staged;
+    EXPECT_EQ(counts.downloads, 1u) << "staged " << staged;
+    EXPECT_EQ(counts.downloadedBytes, 25u * sizeof(double)) << "staged " << staged;
+    EXPECT_EQ(host[0], 1.5);
+    EXPECT_EQ(context.validationMessageCount(), 0u);
   }
 }
 

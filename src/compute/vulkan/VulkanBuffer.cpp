@@ -111,12 +111,13 @@ void Buffer::checkRange(std::size_t bytes, std::size_t offset, const char* opera
 void Buffer::upload(const void* data, std::size_t bytes, std::size_t offset) {
   if (bytes == 0) return;
   checkRange(bytes, offset, "upload");
+  context_->countTransfer(true, bytes);
   if (mapped_) {
     std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
     return;
   }
   Buffer staging(*context_, bytes, MemoryClass::Host, "a staging buffer");
-  staging.upload(data, bytes);
+  std::memcpy(staging.mapped_, data, bytes);  // host-visible; the copy below is the transfer counted
   Sequence sequence(*context_);
   sequence.begin();
   sequence.copy(staging, *this, bytes, 0, offset);
@@ -127,6 +128,7 @@ void Buffer::upload(const void* data, std::size_t bytes, std::size_t offset) {
 void Buffer::download(void* data, std::size_t bytes, std::size_t offset) const {
   if (bytes == 0) return;
   checkRange(bytes, offset, "download");
+  context_->countTransfer(false, bytes);
   if (mapped_) {
     std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
     return;
@@ -137,7 +139,7 @@ void Buffer::download(void* data, std::size_t bytes, std::size_t offset) const {
   sequence.copy(*this, staging, bytes, offset, 0);
   sequence.end();
   sequence.run();
-  staging.download(data, bytes);
+  std::memcpy(data, staging.mapped_, bytes);
 }
 
 }  // namespace plano::vk

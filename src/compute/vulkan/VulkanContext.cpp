@@ -381,6 +381,22 @@ void Context::resetPeakAllocatedBytes() {
   peakUsage_ = totalUsage_;
 }
 
+void Context::countTransfer(bool upload, std::size_t bytes) {
+  std::lock_guard lock(allocationMutex_);
+  if (upload) {
+    transfers_.uploadedBytes += bytes;
+    ++transfers_.uploads;
+  } else {
+    transfers_.downloadedBytes += bytes;
+    ++transfers_.downloads;
+  }
+}
+
+TransferCounts Context::transfers() const {
+  std::lock_guard lock(allocationMutex_);
+  return transfers_;
+}
+
 void Context::releaseMemory(VkDeviceSize bytes, std::uint32_t memoryType) {
   const std::uint32_t heap = memory_.memoryTypes[memoryType].heapIndex;
   std::lock_guard lock(allocationMutex_);

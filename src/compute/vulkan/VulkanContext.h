@@ -42,6 +42,16 @@ struct ContextSettings {
   static ContextSettings fromEnvironment(DeviceSelection selection);
 };
 
+/// Host <-> device copies through Buffer::upload and Buffer::download since the Context was
+/// created: what a loop that is meant to stay on the device still moves (the benchmarks'
+/// transfer counters). A copy into or out of mapped memory counts as one, as a staged one.
+struct TransferCounts {
+  std::uint64_t uploadedBytes = 0;
+  std::uint64_t downloadedBytes = 0;
+  std::uint64_t uploads = 0;
+  std::uint64_t downloads = 0;
+};
+
 /// What the chosen device offers; kernels check it before use.
 struct DeviceInfo {
   std::string name;
@@ -92,6 +102,9 @@ class Context {
   VkDeviceSize allocatedBytes() const;
   VkDeviceSize peakAllocatedBytes() const;
   void resetPeakAllocatedBytes();
+  /// Account for one host-to-device (upload) or device-to-host copy of `bytes` bytes.
+  void countTransfer(bool upload, std::size_t bytes);
+  TransferCounts transfers() const;
   /// What a queue submission reports to its caller: `result`, except VK_ERROR_DEVICE_LOST
   /// from the simulated lost submission on (SimulatedFaults::deviceLostAtSubmit).
   VkResult submissionResult(VkResult result);
@@ -129,6 +142,7 @@ class Context {
   VkDeviceSize totalUsage_ = 0;
   VkDeviceSize peakUsage_ = 0;
   std::uint64_t submissions_ = 0;
+  TransferCounts transfers_;
 
   mutable std::mutex messagesMutex_;
   std::vector<std::string> messages_;
