@@ -223,6 +223,17 @@ void AdmmSolver::setConstraintScales(std::span<const double> scales) {
   factored_ = false;
 }
 
+bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                                 ActiveSetRefinementInfo& info) {
+  if (request.active.size() != static_cast<std::size_t>(m_) || request.targets.rows() != m_) {
+    throwUsage("ADMM: an active set of " + std::to_string(request.active.size()) + " rows and targets of " +
+               std::to_string(request.targets.rows()) + " for " + std::to_string(m_) + " constraint rows");
+  }
+  if (!kernels_->refineActiveSet(request, x, y, info)) return false;
+  factored_ = false;  // K is the polish's now
+  return true;
+}
+
 void AdmmSolver::setRho(double rho) {
   if (!(rho > 0.0) || !std::isfinite(rho)) throwUsage("ADMM: rho must be a finite number > 0");
   rho_ = rho;

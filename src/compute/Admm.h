@@ -140,6 +140,25 @@ struct AdmmMeasures {
   long inexactSolves = 0;          ///< Since start().
 };
 
+/// The polish's refinements with an active set (projective/BoxQp.h), run where the
+/// iterate lives (AdmmKernels::refineActiveSet).
+struct ActiveSetRefinement {
+  std::vector<char> active;            ///< m flags: rows held as equalities.
+  Eigen::MatrixXd targets;             ///< m x k: the active rows' values (others ignored).
+  std::vector<Eigen::Index> columns;   ///< The columns whose residual decides (others come along).
+  double rho = 1e9;                    ///< Penalty of the active rows.
+  int maxRefinements = 30;
+  double goal = 0.0;                   ///< Stop once the active rows' residual is at most this.
+};
+
+/// What refineActiveSet did.
+struct ActiveSetRefinementInfo {
+  bool factored = false;        ///< Its matrix was formed (positive definite blocks) at all.
+  bool solvesConverged = true;  ///< Every inner solve reached its tolerance.
+  int refinements = 0;
+  long linearIterations = 0;
+};
+
 /// The vector work of one backend (see the file comment). Implementations keep x, y, z,
 /// xTilde, the previous y and the problem data; the k columns come with start().
 class AdmmKernels {
@@ -174,6 +193,22 @@ class AdmmKernels {
   virtual void setLinearTolerance(double tolerance) { (void)tolerance; }
   /// The current x, y and z (n x k, m x k, m x k).
   virtual void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) = 0;
+  /// The polish's method of multipliers on the iterate the last iterate() left (or start()
+  /// loaded), where these kernels keep it, so that the polish moves no mesh-sized data per
+  /// refinement: with K_A = P + sigma I + rho C^T diag(active) C, lambda = y on the active
+  /// rows and 0 elsewhere, each refinement solves
+  ///   K_A x' = sigma x - q - C^T lambda + rho C^T diag(active) b   (warm-started at x)
+  /// and updates lambda += rho diag(active) (C x' - b), until the active rows' residual
+  /// (inf-norm over request.columns) is at most request.goal or stops shrinking. Every call
+  /// starts again from that iterate (one call per active set); on exit x (n x k) and y
+  /// (m x k, lambda) hold the result for all k columns, request.columns' being the
+  /// meaningful ones. K is then K_A's: the next setRho forms the ADMM's again. Returns
+  /// false when these kernels have no such step (the caller refines on the host).
+  virtual bool refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                               ActiveSetRefinementInfo& info) {
+    (void)request, (void)x, (void)y, (void)info;
+    return false;
+  }
 };
 
 /// The ADMM control logic over a backend's kernels (see the file comment).
@@ -199,6 +234,11 @@ class AdmmSolver {
   /// before a scaling or of another count.
   void setConstraintScaling(ConstraintScaling scaling);
   void setConstraintScales(std::span<const double> scales);
+
+  /// AdmmKernels::refineActiveSet on the last solve's iterate; false when the kernels have
+  /// none. The next solve forms K again.
+  bool refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                       ActiveSetRefinementInfo& info);
 
   /// The rho the next solve starts at (by default the last solve's final rho): a caller
   /// rewinds it after a solve whose rho ran off (projective/GlobalStep.cpp). Throws

@@ -456,6 +456,92 @@ TEST_F(VulkanAdmm, SmallProblemsRunInOneWorkgroupAndWideOnesRefuseIt) {
   }
 }
 
+// --- The polish on the device (AdmmKernels::refineActiveSet) ------------------------------
+
+/// The equality-constrained QP the polish converges to, by a dense KKT solve:
+/// [P C_A^T; C_A 0] [x; lambda] = [-q; b] per column; lambda scattered to all m rows.
+void activeSetReference(const BoxQp& qp, const std::vector<char>& active, const Eigen::MatrixXd& targets,
+                        Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  const Index n = qp.P.rows(), m = qp.C.rows();
+  std::vector<Index> rows;
+  for (Index i = 0; i < m; ++i) {
+    if (active[static_cast<std::size_t>(i)]) rows.push_back(i);
+  }
+  const auto a = static_cast<Index>(rows.size());
+  const Eigen::MatrixXd C = Eigen::MatrixXd(qp.C);
+  Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + a, n + a);
+  kkt.topLeftCorner(n, n) = Eigen::MatrixXd(qp.P);
+  for (Index r = 0; r < a; ++r) {
+    kkt.block(n + r, 0, 1, n) = C.row(rows[r]);
+    kkt.block(0, n + r, n, 1) = C.row(rows[r]).transpose();
+  }
+  Eigen::MatrixXd rhs(n + a, qp.q.cols());
+  rhs.topRows(n) = -qp.q;
+  for (Index r = 0; r < a; ++r) rhs.row(n + r) = targets.row(rows[r]);
+  const Eigen::MatrixXd solution = kkt.fullPivLu().solve(rhs);
+  x = solution.topRows(n);
+  y = Eigen::MatrixXd::Zero(m, qp.q.cols());
+  for (Index r = 0; r < a; ++r) y.row(rows[r]) = solution.row(n + r);
+}
+
+TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMovingNoMatrix) {
+  // The single-workgroup recording (fast on small problems): the polish records its own
+  // multi-dispatch PCG in either.
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  const compute::AdmmSettings settings;
+  const Recording& recording = kRecordings[1];
+  {
+    auto solver = deviceSolver(context(), qp, settings, recording);
+    auto twin = deviceSolver(context(), qp, settings, recording);  // the same solves, no polish
+    const AdmmRun admm = runAdmm(*solver, qp);
+    runAdmm(*twin, qp);
+    ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+    // The active set of the ADMM's solution (column 0's, for every column), as the polish
+    // takes it (projective/BoxQp.cpp).
+    std::vector<char> active(24, 0);
+    Eigen::MatrixXd targets = qp.lower;
+    Index bounds = 0;
+    for (Index i = 0; i < 24; ++i) {
+      const double l = qp.lower(i, 0), u = qp.upper(i, 0), z = admm.z(i, 0), y = admm.y(i, 0);
+      active[static_cast<std::size_t>(i)] = l == u || z - l < -y || u - z < y;
+      if (l != u && u - z < y) targets.row(i) = qp.upper.row(i);
+      if (l != u && active[static_cast<std::size_t>(i)]) ++bounds;
+    }
+    ASSERT_GT(bounds, 0) << "no inequality row active: the case tests equalities only";
+    // rho milder than the polish's 1e9: this random P with Jacobi blocks would need thousands of
+    // PCG iterations per solve there, and the solution is the same.
+    const compute::ActiveSetRefinement request{active, targets, {0}, 1e6, 30, 1e-15};
+    Eigen::MatrixXd xReference, yReference;
+    activeSetReference(qp, active, targets, xReference, yReference);
+
+    const vk::TransferCounts before = context().transfers();
+    Eigen::MatrixXd x, y;
+    compute::ActiveSetRefinementInfo info;
+    ASSERT_TRUE(solver->refineActiveSet(request, x, y, info));
+    const vk::TransferCounts after = context().transfers();
+    EXPECT_TRUE(info.factored);
+    EXPECT_TRUE(info.solvesConverged);
+    EXPECT_GE(info.refinements, 2);
+    EXPECT_LT(relativeDifference(x.col(0), xReference.col(0)), 1e-9);
+    EXPECT_LT(relativeDifference(y.col(0), yReference.col(0)), 1e-6);
+    for (Index i = 0; i < 24; ++i) {
+      if (!active[static_cast<std::size_t>(i)]) EXPECT_EQ(y.row(i).cwiseAbs().maxCoeff(), 0.0) << "row " << i;
+    }
+    // Up: the active flags and the targets (and a few scalars); down: x and y once, and
+    // per refinement or resumed PCG run only norms and the PCG state. K_A is formed on
+    // the device.
+    EXPECT_LE(after.uploadedBytes - before.uploadedBytes, sizeof(double) * (24 + 24 * 3) + 64);
+    const auto runs = static_cast<std::size_t>(info.refinements + info.linearIterations / 32 + 1);
+    EXPECT_LE(after.downloadedBytes - before.downloadedBytes, sizeof(double) * (30 * 3 + 24 * 3) + runs * 512);
+
+    // The next solve is the one of a solver that did not polish: K_A does not stay behind.
+    const AdmmRun again = runAdmm(*solver, qp);
+    const AdmmRun reference = runAdmm(*twin, qp);
+    EXPECT_EQ(again.info.iterations, reference.info.iterations);
+    EXPECT_LT(relativeDifference(again.x, reference.x), 1e-10);
+  }
+}
+
 // --- A real global-step QP, captured from a CPU global step ------------------------------
 
 /// Host kernels that remember the problem of their first start().

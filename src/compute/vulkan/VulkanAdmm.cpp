@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
@@ -212,6 +214,21 @@ struct AdmmKernels::Workspace {
   /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
   /// single-workgroup by 8192 * iteration count + dispatch count.
   std::map<int, std::unique_ptr<Sequence>> blocks;
+  /// refineActiveSet's: the iterate it starts every call from (saved by its first call
+  /// after start() or iterate()), and its recordings.
+  struct Polish {
+    Polish(Context& context, std::uint32_t n, std::uint32_t m, std::uint32_t k)
+        : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"), save(context),
+          begin(context), solve(context), resume(context), update(context) {}
+    DeviceVectors x0, y0;
+    Sequence save;    ///< x0 = x, y0 = y
+    Sequence begin;   ///< x = x0, lambda = y = diag(active) y0
+    Sequence solve;   ///< The refinement's right-hand side and PCG from xTilde = x.
+    Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
+    Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
+  };
+  std::unique_ptr<Polish> polish;
+  bool polishStartSaved = false;
 };
 
 AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
@@ -317,20 +334,29 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   if (!k1Current_ || equality != equality_) {
     std::vector<double> D(m_);
     for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
-    rowScales_.upload(D);
-    const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
-    assembly_.begin();
-    assembly_.dispatch(k1Assemble_,
-                       {k1TermOffsets_, k1TermA_, k1TermB_, devC_.values(), cEntryRows_, rowScales_, k1Values_},
-                       K1AssemblePush{nonZeros}, groupsFor(context_, nonZeros));
-    assembly_.barrier();
-    if (multigrid_) multigrid_->setK1(assembly_, k1Values_);
-    assembly_.end();
-    assembly_.run();
-    if (multigrid_) multigrid_->readCoarsestK1();
+    assembleK1(D);
     equality_ = equality;
     k1Current_ = true;
   }
+  assembleK(rho);
+  longFirstSolve_ = true;
+}
+
+void AdmmKernels::assembleK1(const std::vector<double>& rowScales) {
+  rowScales_.upload(rowScales);
+  const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
+  assembly_.begin();
+  assembly_.dispatch(k1Assemble_,
+                     {k1TermOffsets_, k1TermA_, k1TermB_, devC_.values(), cEntryRows_, rowScales_, k1Values_},
+                     K1AssemblePush{nonZeros}, groupsFor(context_, nonZeros));
+  assembly_.barrier();
+  if (multigrid_) multigrid_->setK1(assembly_, k1Values_);
+  assembly_.end();
+  assembly_.run();
+  if (multigrid_) multigrid_->readCoarsestK1();
+}
+
+void AdmmKernels::assembleK(double rho) {
   const std::uint32_t noFailure = ~0u;
   blockFailure_.upload({&noFailure, 1});
   const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
@@ -358,7 +384,6 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
       throwNumerical("ADMM: a diagonal block of a coarse multigrid level of K is not positive definite (nor then is K)");
     }
   }
-  longFirstSolve_ = true;
 }
 
 void AdmmKernels::setConstraintValues(const compute::SparseMatrix& C) {
@@ -528,21 +553,25 @@ void AdmmKernels::prepare(std::uint32_t k) {
   s.end();
 }
 
-void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations) {
+void AdmmKernels::recordRightHandSide(Sequence& s) {
   Workspace& w = *workspace_;
-  LinearAlgebra& la = algebra_;
-  const std::uint32_t k = w.k;
-  const std::uint32_t mk = m_ * k;
-  const std::uint32_t nk = n_ * k;
-
+  const std::uint32_t mk = m_ * w.k;
+  const std::uint32_t nk = n_ * w.k;
   // rhs = sigma x - q + C^T (rho z - y)
   s.dispatch(rhs_, {w.z.data(), w.y.data(), rhoRows_, w.w.data()}, RhsPush{m_, mk, 0, 0, settings_.sigma},
              groupsFor(context_, mk));
   s.barrier();
-  la.spmv(s, devCt_, w.w, w.Ctw);
+  algebra_.spmv(s, devCt_, w.w, w.Ctw);
   s.dispatch(rhs_, {w.x.data(), w.q.data(), w.Ctw.data(), w.rhs.data()}, RhsPush{n_, nk, 1, 0, settings_.sigma},
              groupsFor(context_, nk));
   s.barrier();
+}
+
+void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations) {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  const std::uint32_t k = w.k;
+  const std::uint32_t nk = n_ * k;
 
   // PCG start from xTilde: r = rhs - K xTilde, preconditioned = M^-1 r, p = it, r.z, r.r, b.z.
   la.spmv(s, devK_, w.xTilde, w.Kp);
@@ -597,6 +626,15 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
     s.barrier();
     control(j + 1 == innerIterations ? 2 : 1, next);
   }
+}
+
+void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations) {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  const std::uint32_t mk = m_ * w.k;
+
+  recordRightHandSide(s);
+  recordInnerSolve(s, innerIterations);
 
   // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
   const double alpha = settings_.relaxation;
@@ -690,6 +728,7 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   w.state.upload(zeros);
   w.innerIterationsSeen = 0.0;
   w.uploadedTolerance = -1.0;
+  w.polishStartSaved = false;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
   w.start.run();
@@ -702,6 +741,7 @@ void AdmmKernels::setLinearTolerance(double tolerance) {
 
 void AdmmKernels::iterate(int count) {
   if (!workspace_ || count <= 0) return;
+  workspace_->polishStartSaved = false;
   if (workspace_->uploadedTolerance != linearTolerance_) {
     const double squared = linearTolerance_ * linearTolerance_;
     workspace_->state.upload({&squared, 1}, kLinearTolerance2);
@@ -759,6 +799,122 @@ void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::Matrix
   workspace_->x.download(x);
   workspace_->y.download(y);
   workspace_->z.download(z);
+}
+
+
+
+void AdmmKernels::recordPolish() {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  Workspace::Polish& p = *w.polish;
+  const int cap = std::min(kPolishInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+  p.save.begin();
+  la.copy(p.save, w.x, p.x0);
+  la.copy(p.save, w.y, p.y0);
+  p.save.end();
+  // rowScales_ holds the active flags (assembleK1), rhoRows_ = rho times them (assembleK).
+  p.begin.begin();
+  la.copy(p.begin, p.x0, w.x);
+  la.scaleRows(p.begin, rowScales_, p.y0, w.y);
+  p.begin.end();
+  // With z = b the ADMM's right-hand side is the refinement's:
+  //   sigma x - q + C^T (rho diag(active) b - lambda).
+  p.solve.begin();
+  recordRightHandSide(p.solve);
+  la.copy(p.solve, w.x, w.xTilde);
+  recordInnerSolve(p.solve, cap);
+  p.solve.end();
+  p.resume.begin();
+  recordInnerSolve(p.resume, cap);
+  p.resume.end();
+  // r = diag(active) (C x - b) (in zTilde), lambda += rho r; the norms of r, x and lambda.
+  p.update.begin();
+  la.copy(p.update, w.xTilde, w.x);
+  la.spmv(p.update, devC_, w.x, w.Cx);
+  la.axpby(p.update, -1.0, w.z, 1.0, w.Cx);
+  la.scaleRows(p.update, rowScales_, w.Cx, w.zTilde);
+  la.scaleRows(p.update, rhoRows_, w.Cx, w.dy);
+  la.axpby(p.update, 1.0, w.dy, 1.0, w.y);
+  la.maxAbs(p.update, w.zTilde, w.measures, kPrimal);
+  la.maxAbs(p.update, w.x, w.measures, kX);
+  la.maxAbs(p.update, w.y, w.measures, kY);
+  p.update.end();
+}
+
+bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x,
+                                  Eigen::MatrixXd& y, compute::ActiveSetRefinementInfo& info) {
+  if (!workspace_) return false;  // no iterate (k = 0)
+  Workspace& w = *workspace_;
+  if (request.active.size() != m_ || request.targets.rows() != m_ || request.targets.cols() != w.k) {
+    throwUsage("ADMM: an active set or its targets do not match the " + std::to_string(m_) + " x " +
+               std::to_string(w.k) + " constraint values");
+  }
+  for (const Eigen::Index c : request.columns) {
+    if (c < 0 || c >= static_cast<Eigen::Index>(w.k)) throwUsage("ADMM: a polished column is out of range");
+  }
+  if (!w.polish) {
+    w.polish = std::make_unique<Workspace::Polish>(context_, n_, m_, w.k);
+    recordPolish();
+  }
+  Workspace::Polish& p = *w.polish;
+  if (!w.polishStartSaved) {
+    p.save.run();
+    w.polishStartSaved = true;
+  }
+
+  // K_A = K0 + rho C^T diag(active) C: the ADMM's K with the active flags as row scales.
+  std::vector<double> flags(m_);
+  for (std::uint32_t i = 0; i < m_; ++i) flags[i] = request.active[i] ? 1.0 : 0.0;
+  k1Current_ = false;  // K1 is the polish's from here on; the next setRho forms the ADMM's
+  longFirstSolve_ = true;
+  try {
+    assembleK1(flags);
+    assembleK(request.rho);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Numerical) throw;
+    return true;  // not factored: the ADMM's solution stands
+  }
+  info.factored = true;
+  w.z.upload(request.targets);
+  p.begin.run();
+
+  // Only the relative tolerance stops these solves (no bound from ADMM residuals).
+  const double noBound = std::numeric_limits<double>::max();
+  w.state.upload({&noBound, 1}, kLinearTolerance2);
+  w.uploadedTolerance = -1.0;
+  double state[kStateSize];
+  w.state.download(state);
+  const double iterationsBefore = state[kInnerIterations];
+  const long maxIterations = std::max(1, settings_.linearSolver.maxIterations);
+  double previous = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < request.maxRefinements; ++r) {
+    throwIfCancelled("the polish");
+    double solveStart = state[kInnerIterations];
+    double capped = state[kCappedSolves];
+    p.solve.run();
+    w.state.download(state);
+    while (state[kCappedSolves] > capped && state[kInnerIterations] - solveStart < maxIterations) {
+      capped = state[kCappedSolves];
+      p.resume.run();  // restarts PCG from the iterate reached
+      w.state.download(state);
+    }
+    if (state[kCappedSolves] > capped) info.solvesConverged = false;
+    p.update.run();
+    ++info.refinements;
+    const std::vector<double> norms = w.measures.read();
+    double residual = 0.0;
+    for (const Eigen::Index c : request.columns) {
+      const double value = w.measures.at(norms, kPrimal, static_cast<std::uint32_t>(c));
+      residual = std::isnan(value) ? value : std::max(residual, value);
+      if (std::isnan(residual)) break;
+    }
+    if (!(residual > request.goal) || residual >= previous) break;  // NaN too: the caller rejects it
+    previous = residual;
+  }
+  info.linearIterations = static_cast<long>(state[kInnerIterations] - iterationsBefore);
+  w.x.download(x);
+  w.y.download(y);
+  return true;
 }
 
 }  // namespace plano::vk

@@ -66,6 +66,11 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// cap bounds the recording's size (empty dispatches are not free).
   static constexpr int kInitialInnerIterations = 256;
   static constexpr int kMaxInnerIterations = 1024;
+  /// Recorded PCG iterations per run of a polish solve (refineActiveSet), which resumes
+  /// from its iterate until the solve converges: warm-started at the ADMM's solution those
+  /// solves need tens of iterations, and the recorded ones past convergence still cost
+  /// their (empty) dispatches.
+  static constexpr int kPolishInnerIterations = 64;
   /// Automatic recording uses one workgroup up to this many unknowns per column: one
   /// workgroup then sweeps a vector in at most a few hundred rows per invocation.
   static constexpr std::uint32_t kSingleWorkgroupUnknowns = 1u << 16;
@@ -105,12 +110,25 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
+  /// On the device: K_A is assembled as K (the active flags as K1's row scales), each
+  /// refinement is the ADMM's right-hand side (with z = b) and inner PCG, then one update;
+  /// per refinement only the k residual norms and the PCG state come back. Throws
+  /// Error(Usage) for an active set or targets of the wrong size.
+  bool refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                       compute::ActiveSetRefinementInfo& info) override;
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
   void prepare(std::uint32_t k);
   Sequence& block(int count, bool longFirstSolve);
+  /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
+  /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
+  void assembleK1(const std::vector<double>& rowScales);
+  void assembleK(double rho);
+  void recordRightHandSide(Sequence& s);
+  void recordInnerSolve(Sequence& s, int innerIterations);
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);
+  void recordPolish();
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
   void iterateSingleWorkgroup(int count);
   std::uint32_t singleWorkgroupBudget(std::uint32_t k) const;
