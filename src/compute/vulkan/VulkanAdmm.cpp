@@ -824,8 +824,10 @@ void AdmmKernels::recordPolish() {
   la.copy(p.solve, w.x, w.xTilde);
   recordInnerSolve(p.solve, cap);
   p.solve.end();
+  // A solve that needs more goes on with the ADMM's longest recording: a PCG restarted
+  // every few dozen iterations converges far slower on the stiff K_A.
   p.resume.begin();
-  recordInnerSolve(p.resume, cap);
+  recordInnerSolve(p.resume, std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations)));
   p.resume.end();
   // r = diag(active) (C x - b) (in zTilde), lambda += rho r; the norms of r, x and lambda.
   p.update.begin();
@@ -843,7 +845,9 @@ void AdmmKernels::recordPolish() {
 
 bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x,
                                   Eigen::MatrixXd& y, compute::ActiveSetRefinementInfo& info) {
-  if (!workspace_) return false;  // no iterate (k = 0)
+  // No iterate (k = 0), or no rows to hold (m = 0: the host's unconstrained solve; the
+  // device would copy empty vectors, which Vulkan forbids).
+  if (!workspace_ || m_ == 0) return false;
   Workspace& w = *workspace_;
   if (request.active.size() != m_ || request.targets.rows() != m_ || request.targets.cols() != w.k) {
     throwUsage("ADMM: an active set or its targets do not match the " + std::to_string(m_) + " x " +
