@@ -5,7 +5,9 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <functional>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -55,6 +57,18 @@ struct LinearSolveInfo {
   double relativeResidual = 0.0;
   bool converged = true;
 };
+
+/// Copies between host and device memory (Backend::transfers): what a loop meant to stay on
+/// the device still moves.
+struct DeviceTransfers {
+  std::uint64_t uploadedBytes = 0;
+  std::uint64_t downloadedBytes = 0;
+  std::uint64_t copies = 0;  ///< Each one a synchronisation with the device.
+};
+
+/// The copies made between two readings of Backend::transfers (nullopt where either is).
+std::optional<DeviceTransfers> transfersSince(const std::optional<DeviceTransfers>& before,
+                                              const std::optional<DeviceTransfers>& after);
 
 /// Solver for A X = B with A symmetric positive definite, A fixed at construction
 /// (factored or uploaded once), many right-hand sides over its lifetime.
@@ -119,6 +133,10 @@ class Backend {
   /// called only by a backend that uses it (building it costs O(d^2 #V) on the host).
   virtual std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
       const std::function<ReducedArapProblem()>& problem);
+
+  /// Host <-> device copies since this backend was created; nullopt for a backend whose
+  /// data never leaves the host (the CPU).
+  virtual std::optional<DeviceTransfers> transfers() const { return std::nullopt; }
 };
 
 /// Which backend the user asked for.

@@ -5,6 +5,13 @@
 
 namespace plano::compute {
 
+std::optional<DeviceTransfers> transfersSince(const std::optional<DeviceTransfers>& before,
+                                              const std::optional<DeviceTransfers>& after) {
+  if (!before || !after) return std::nullopt;
+  return DeviceTransfers{after->uploadedBytes - before->uploadedBytes,
+                         after->downloadedBytes - before->downloadedBytes, after->copies - before->copies};
+}
+
 BackendChoice parseBackendChoice(const std::string& text) {
   if (text == "cpu") return BackendChoice::Cpu;
   if (text == "vulkan") return BackendChoice::Vulkan;

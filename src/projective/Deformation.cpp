@@ -51,8 +51,10 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
   const double diagonal = space_.normalization().scale;
   const double planarityBound = std::max(settings_.planarityTolerance, planarityStats(space_.baseMesh()).max);
   DeformationInfo info;
+  std::optional<compute::DeviceTransfers> transfersBefore;
   auto record = [&](DeformationPhase phase, const GlobalStepInfo& step, const Positions& next) {
     DeformationIteration it;
+    it.transfers = compute::transfersSince(transfersBefore, backend_.transfers());
     it.iteration = ++info.iterations;
     it.phase = phase;
     it.epsilon = step.epsilon;
@@ -75,6 +77,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     // Phase 1 (§6.1): fit, closest rigid/similar map, global step.
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       throwIfCancelled("deformation");
+      transfersBefore = backend_.transfers();
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const Positions normalized = space_.normalization().toNormalized(positions);
       const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy, &normalized);
@@ -89,6 +92,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
     for (int k = 0; k < settings_.maxProjectionIterations && !planar; ++k) {
       throwIfCancelled("deformation (projection)");
+      transfersBefore = backend_.transfers();
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
       const Positions next = space_.positions(maps.maps);

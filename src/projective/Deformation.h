@@ -65,6 +65,8 @@ struct DeformationIteration {
   double displacement = 0.0;        ///< Max vertex move this iteration / bounding-box diagonal.
   double maxPlanarity = 0.0;        ///< Percent, after the iteration.
   std::vector<EpsilonAttempt> attempts;  ///< The eps schedule of the global step.
+  /// Host <-> device copies of the iteration (compute::Backend::transfers; none on the CPU).
+  std::optional<compute::DeviceTransfers> transfers;
 };
 
 struct DeformationInfo {

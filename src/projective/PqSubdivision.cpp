@@ -46,6 +46,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
   PolygonMesh current{targets, refined.faces};
   for (int iteration = 0; iteration < settings.maxIterationsPerLevel; ++iteration) {
     throwIfCancelled("subdivision");
+    const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
     const LocalStepResult local = fitFaceMaps(backend, space, target);
     const GlobalStepInfo step = global.solve(local.fits.maps, Positions(), maps);
     current.vertices = space.positions(maps.maps);
@@ -58,6 +59,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.attempts = step.attempts;
     record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
     record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;
+    record.transfers = compute::transfersSince(transfersBefore, backend.transfers());
     info.iterations.push_back(record);
     if (callback) callback(info.level, iteration + 1, info.iterations.back());
     if (record.maxPlanarity <= settings.planarityTolerance && record.maxChange <= settings.changeTolerance) {

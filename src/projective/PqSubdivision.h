@@ -53,6 +53,8 @@ struct PqIteration {
   int admmIterations = 0;
   long linearIterations = 0;     ///< Of the ADMM's solves with K (GlobalStepInfo::linearIterations).
   std::vector<EpsilonAttempt> attempts;  ///< The global step's ε schedule, in order.
+  /// Host <-> device copies of the iteration (compute::Backend::transfers; none on the CPU).
+  std::optional<compute::DeviceTransfers> transfers;
 };
 
 struct PqLevelInfo {

@@ -525,7 +525,9 @@ TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMo
     EXPECT_LT(relativeDifference(x.col(0), xReference.col(0)), 1e-9);
     EXPECT_LT(relativeDifference(y.col(0), yReference.col(0)), 1e-6);
     for (Index i = 0; i < 24; ++i) {
-      if (!active[static_cast<std::size_t>(i)]) EXPECT_EQ(y.row(i).cwiseAbs().maxCoeff(), 0.0) << "row " << i;
+      if (!active[static_cast<std::size_t>(i)]) {
+        EXPECT_EQ(y.row(i).cwiseAbs().maxCoeff(), 0.0) << "row " << i;
+      }
     }
     // Up: the active flags and the targets (and a few scalars); down: x and y once, and
     // per refinement or resumed PCG run only norms and the PCG state. K_A is formed on

@@ -25,6 +25,13 @@ nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>
   return list;
 }
 
+void addTransfers(nlohmann::json& entry, const std::optional<compute::DeviceTransfers>& transfers) {
+  if (!transfers) return;
+  entry["device_transfers"] = {{"uploaded_bytes", transfers->uploadedBytes},
+                               {"downloaded_bytes", transfers->downloadedBytes},
+                               {"copies", transfers->copies}};
+}
+
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,
                           const PlanarityStats& planarity, double seconds) {
   return {{"command", command},

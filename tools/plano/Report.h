@@ -3,7 +3,10 @@
 // command keeps: command, backend, vertices, faces, planarity {max, mean, p95,
 // over_tolerance, tolerance}, seconds, and iterations wherever there are any.
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+
+#include "compute/Backend.h"
 
 #include "core/Error.h"
 #include "mesh/Planarity.h"
@@ -16,6 +19,10 @@ nlohmann::json planarityJson(const PlanarityStats& stats);
 
 /// A global step's ε schedule: [{epsilon, status, iterations}] in the order tried.
 nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>& attempts);
+
+/// Add `device_transfers` {uploaded_bytes, downloaded_bytes, copies} to an iteration's
+/// entry when the backend counted them (a device backend).
+void addTransfers(nlohmann::json& entry, const std::optional<compute::DeviceTransfers>& transfers);
 
 /// The common keys of a report for a command that produced `mesh`.
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,

@@ -20,6 +20,11 @@ VulkanBackend::~VulkanBackend() = default;
 
 std::string VulkanBackend::name() const { return "vulkan (" + context_->info().name + ")"; }
 
+std::optional<DeviceTransfers> VulkanBackend::transfers() const {
+  const vk::TransferCounts counts = context_->transfers();
+  return DeviceTransfers{counts.uploadedBytes, counts.downloadedBytes, counts.uploads + counts.downloads};
+}
+
 void VulkanBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out) {
   if (!planarity_) planarity_ = std::make_unique<vk::FacePlanarityKernel>(*context_);
   planarity_->run(mesh, out);

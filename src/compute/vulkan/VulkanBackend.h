@@ -47,6 +47,8 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
       const std::function<ReducedArapProblem()>& problem) override;
 
+  std::optional<DeviceTransfers> transfers() const override;
+
   /// The device context (device properties, validation messages).
   vk::Context& context() { return *context_; }
 

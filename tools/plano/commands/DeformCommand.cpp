@@ -58,7 +58,7 @@ struct DeformOutcome {
 };
 
 nlohmann::json iterationJson(const projective::DeformationIteration& it) {
-  return {{"iteration", it.iteration},
+  nlohmann::json entry = {{"iteration", it.iteration},
           {"phase", it.phase == projective::DeformationPhase::Ideal ? "ideal" : "projection"},
           {"epsilon", it.epsilon},
           {"initial_violation", it.initialViolation},
@@ -69,6 +69,8 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
           {"displacement", it.displacement},
           {"max_planarity", it.maxPlanarity},
           {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};
+  addTransfers(entry, it.transfers);
+  return entry;
 }
 
 /// Which stopping bound the last rigid/similar iteration missed, with its tolerance.

@@ -32,13 +32,15 @@ nlohmann::json levelJson(const projective::PqLevelInfo& level) {
   nlohmann::json steps = nlohmann::json::array();
   for (const auto& it : level.iterations) {
     epsilons.push_back(it.epsilon);
-    steps.push_back({{"epsilon", it.epsilon},
-                     {"max_planarity", it.maxPlanarity},
-                     {"max_change", it.maxChange},
-                     {"constraint_residual", it.constraintResidual},
-                     {"admm_iterations", it.admmIterations},
-                     {"linear_iterations", it.linearIterations},
-                     {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}});
+    nlohmann::json step = {{"epsilon", it.epsilon},
+                           {"max_planarity", it.maxPlanarity},
+                           {"max_change", it.maxChange},
+                           {"constraint_residual", it.constraintResidual},
+                           {"admm_iterations", it.admmIterations},
+                           {"linear_iterations", it.linearIterations},
+                           {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};
+    addTransfers(step, it.transfers);
+    steps.push_back(std::move(step));
   }
   return {{"level", level.level},
           {"vertices", level.vertices},
