@@ -229,9 +229,15 @@ bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::Matr
     throwUsage("ADMM: an active set of " + std::to_string(request.active.size()) + " rows and targets of " +
                std::to_string(request.targets.rows()) + " for " + std::to_string(m_) + " constraint rows");
   }
-  if (!kernels_->refineActiveSet(request, x, y, info)) return false;
-  factored_ = false;  // K is the polish's now
-  return true;
+  bool refined = false;
+  try {
+    refined = kernels_->refineActiveSet(request, x, y, info);
+  } catch (...) {
+    factored_ = false;  // K may be the polish's
+    throw;
+  }
+  if (refined) factored_ = false;  // K is the polish's now
+  return refined;
 }
 
 void AdmmSolver::setRho(double rho) {

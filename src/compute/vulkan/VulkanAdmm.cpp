@@ -829,7 +829,8 @@ void AdmmKernels::recordPolish() {
   p.resume.begin();
   recordInnerSolve(p.resume, std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations)));
   p.resume.end();
-  // r = diag(active) (C x - b) (in zTilde), lambda += rho r; the norms of r, x and lambda.
+  // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
+  // lambda reaches it).
   p.update.begin();
   la.copy(p.update, w.xTilde, w.x);
   la.spmv(p.update, devC_, w.x, w.Cx);
@@ -838,8 +839,6 @@ void AdmmKernels::recordPolish() {
   la.scaleRows(p.update, rhoRows_, w.Cx, w.dy);
   la.axpby(p.update, 1.0, w.dy, 1.0, w.y);
   la.maxAbs(p.update, w.zTilde, w.measures, kPrimal);
-  la.maxAbs(p.update, w.x, w.measures, kX);
-  la.maxAbs(p.update, w.y, w.measures, kY);
   p.update.end();
 }
 
@@ -893,7 +892,7 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   double previous = std::numeric_limits<double>::infinity();
   for (int r = 0; r < request.maxRefinements; ++r) {
     throwIfCancelled("the polish");
-    double solveStart = state[kInnerIterations];
+    const double solveStart = state[kInnerIterations];
     double capped = state[kCappedSolves];
     p.solve.run();
     w.state.download(state);
