@@ -544,6 +544,29 @@ TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMo
   }
 }
 
+TEST_F(VulkanAdmm, HostKernelsLeaveThePolishToTheCallerAndWrongActiveSetsAreUsageErrors) {
+  const BoxQp qp = randomBoxQp(24, 18, 5);
+  compute::CpuBackend cpu;
+  const compute::AdmmSettings settings;
+  auto host = cpu.createAdmmSolver(qp.P, qp.C, settings);
+  runAdmm(*host, qp);
+  const compute::ActiveSetRefinement request{std::vector<char>(18, 1), qp.lower, {0, 1, 2}, 1e9, 30, 1e-15};
+  Eigen::MatrixXd x, y;
+  compute::ActiveSetRefinementInfo info;
+  EXPECT_FALSE(host->refineActiveSet(request, x, y, info));  // BoxQpSolver refines on the host
+  EXPECT_EQ(x.size(), 0);
+  EXPECT_EQ(info.refinements, 0);
+
+  auto device = deviceSolver(context(), qp, settings, kRecordings[1]);
+  runAdmm(*device, qp);
+  compute::ActiveSetRefinement wrong = request;
+  wrong.active.resize(17);
+  EXPECT_THROW(device->refineActiveSet(wrong, x, y, info), Error);
+  wrong = request;
+  wrong.columns = {3};
+  EXPECT_THROW(device->refineActiveSet(wrong, x, y, info), Error);
+}
+
 // --- A real global-step QP, captured from a CPU global step ------------------------------
 
 /// Host kernels that remember the problem of their first start().
