@@ -154,6 +154,23 @@ TEST_F(VulkanProjectiveFit, MatchesCpuOnRandomTriangles) {
   expectAgreement(compare(backend(), mesh.faces, mesh.vertices, perturbed(mesh.vertices, 0.05, 2)));
 }
 
+TEST_F(VulkanProjectiveFit, ARepeatedSourceAndTopologyStayOnTheDeviceAndChangedOnesAreUploaded) {
+  const PolygonMesh mesh = generate::translationalSurface(5, 5);
+  const Positions first = applyMap(mesh.vertices, mildProjectiveMap());
+  const Positions second = perturbed(first, 0.02, 3);
+  compute::ProjectiveFits fits;
+  backend().fitProjectiveMaps(mesh.faces, mesh.vertices, first, fits);
+  const vk::TransferCounts before = context().transfers();
+  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, second));
+  const vk::TransferCounts after = context().transfers();
+  EXPECT_EQ(after.uploads - before.uploads, 1u);  // the targets only
+  EXPECT_EQ(after.uploadedBytes - before.uploadedBytes, static_cast<std::uint64_t>(mesh.vertices.size()) * 8u);
+  // A new source, then a new topology, are uploaded, and the fits are theirs.
+  expectAgreement(compare(backend(), mesh.faces, first, second));
+  const PolygonMesh other = generate::translationalSurface(4, 6);
+  expectAgreement(compare(backend(), other.faces, other.vertices, applyMap(other.vertices, mildProjectiveMap())));
+}
+
 TEST_F(VulkanProjectiveFit, MismatchedPositionArraysAreAUsageError) {
   const PolygonMesh mesh = generate::cube();
   Positions fewer = mesh.vertices.topRows(4);

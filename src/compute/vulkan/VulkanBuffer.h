@@ -3,9 +3,11 @@
 // Device buffers live in device-local memory; where that memory is also host visible
 // (lavapipe, integrated GPUs) they are mapped and written directly, otherwise every
 // upload/download goes through a temporary staging buffer.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "compute/vulkan/VulkanContext.h"
 
@@ -82,5 +84,30 @@ void ensureCapacity(Array<T>& array, Context& context, std::size_t count, const 
     array = Array<T>(context, count, MemoryClass::Device, what);
   }
 }
+
+/// A Device array that a kernel called every iteration of a loop fills with inputs that
+/// often repeat (a mesh's topology, a loop's fixed source positions): the upload is skipped
+/// when the values equal the last upload's, compared with a host copy kept for that.
+/// Comparing costs a pass over host memory; on a discrete GPU the skipped copy is a PCIe
+/// transfer and a synchronisation.
+template <class T>
+class CachedArray {
+ public:
+  /// Make the device array hold `values` (grown as ensureCapacity grows).
+  void assign(Context& context, std::span<const T> values, const char* what) {
+    const bool same = array_.handle() != VK_NULL_HANDLE && last_.size() == values.size() &&
+                      std::equal(values.begin(), values.end(), last_.begin());
+    if (same) return;
+    last_.clear();  // an upload that throws leaves nothing claimed
+    ensureCapacity(array_, context, values.size(), what);
+    array_.upload(values);
+    last_.assign(values.begin(), values.end());
+  }
+  Array<T>& array() { return array_; }
+
+ private:
+  Array<T> array_;
+  std::vector<T> last_;
+};
 
 }  // namespace plano::vk

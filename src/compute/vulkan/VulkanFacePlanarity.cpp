@@ -38,17 +38,15 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
 
   ensureCapacity(positions_, context_, mesh.vertices.size(), "vertex positions");
   positions_.upload({mesh.vertices.data(), static_cast<std::size_t>(mesh.vertices.size())});
-  ensureCapacity(offsets_, context_, mesh.faces.offsets().size(), "face offsets");
-  offsets_.upload(mesh.faces.offsets());
-  ensureCapacity(indices_, context_, mesh.faces.indices().size(), "face corners");
-  indices_.upload(mesh.faces.indices());
+  offsets_.assign(context_, mesh.faces.offsets(), "face offsets");
+  indices_.assign(context_, mesh.faces.indices(), "face corners");
 
   // The output is the one per-face array; split the faces so each chunk's fits one binding.
   const std::size_t chunk = std::min(faceCount, range / sizeof(double));
   ensureCapacity(values_, context_, chunk, "face planarity");
   DescriptorSet set(context_, pipeline_,
-                    {BufferRange(positions_, 0, positionBytes), BufferRange(offsets_), BufferRange(indices_),
-                     BufferRange(values_, 0, chunk * sizeof(double))});
+                    {BufferRange(positions_, 0, positionBytes), BufferRange(offsets_.array()),
+                     BufferRange(indices_.array()), BufferRange(values_, 0, chunk * sizeof(double))});
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount; first += chunk) {
     const std::size_t count = std::min(chunk, faceCount - first);

@@ -23,8 +23,8 @@ class FacePlanarityKernel {
   Pipeline pipeline_;
   // Reused across calls (grow-only).
   Array<double> positions_;
-  Array<Index> offsets_;
-  Array<Index> indices_;
+  CachedArray<Index> offsets_;  ///< A loop measures one topology every iteration.
+  CachedArray<Index> indices_;
   Array<double> values_;
 };
 

@@ -49,14 +49,11 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                 std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
                 std::to_string(range) + " bytes; use the CPU backend");
   }
-  ensureCapacity(source_, context_, source.size(), "source positions");
-  source_.upload({source.data(), static_cast<std::size_t>(source.size())});
+  source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
   ensureCapacity(target_, context_, target.size(), "target positions");
   target_.upload({target.data(), static_cast<std::size_t>(target.size())});
-  ensureCapacity(offsets_, context_, faces.offsets().size(), "face offsets");
-  offsets_.upload(faces.offsets());
-  ensureCapacity(indices_, context_, faces.indices().size(), "face corners");
-  indices_.upload(faces.indices());
+  offsets_.assign(context_, faces.offsets(), "face offsets");
+  indices_.assign(context_, faces.indices(), "face corners");
 
   // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
   // fit one storage binding.
@@ -74,8 +71,9 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
   ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
   ensureCapacity(ranks_, context_, maxFaces, "fit ranks");
   DescriptorSet set(context_, pipeline_,
-                    {BufferRange(source_, 0, positionBytes), BufferRange(target_, 0, positionBytes),
-                     BufferRange(offsets_), BufferRange(indices_), BufferRange(maps_, 0, maxFaces * kMapBytes),
+                    {BufferRange(source_.array(), 0, positionBytes), BufferRange(target_, 0, positionBytes),
+                     BufferRange(offsets_.array()), BufferRange(indices_.array()),
+                     BufferRange(maps_, 0, maxFaces * kMapBytes),
                      BufferRange(scales_, 0, maxCorners * sizeof(double)),
                      BufferRange(residuals_, 0, maxFaces * sizeof(double)),
                      BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});

@@ -28,8 +28,9 @@ class ProjectiveFitKernel {
   ProjectiveFitSettings settings_;
   Pipeline pipeline_;
   // Reused across calls (grow-only): a local/global loop allocates once.
-  Array<double> source_, target_;
-  Array<Index> offsets_, indices_;
+  CachedArray<double> source_;  ///< A loop fits to one source (the base mesh) every iteration.
+  Array<double> target_;
+  CachedArray<Index> offsets_, indices_;
   Array<double> maps_, scales_, residuals_;
   Array<std::int32_t> ranks_;
 };
