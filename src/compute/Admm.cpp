@@ -77,8 +77,8 @@ class HostAdmmKernels final : public AdmmKernels {
     q_ = q;
     lower_ = lower;
     upper_ = upper;
-    x_ = x;
-    y_ = y;
+    x_ = x.size() > 0 ? x : Eigen::MatrixXd::Zero(q.rows(), q.cols());
+    y_ = y.size() > 0 ? y : Eigen::MatrixXd::Zero(lower.rows(), q.cols());
     z_ = (C_ * x_).cwiseMax(lower_).cwiseMin(upper_);
     xTilde_ = x_;
     yPrevious_ = y_;
@@ -252,9 +252,8 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     throwUsage("ADMM: q, lower and upper must be n x k, m x k, m x k");
   }
   if ((lower.array() > upper.array()).any()) throwUsage("ADMM: a lower bound exceeds its upper bound");
-  if (x.size() == 0) x = Eigen::MatrixXd::Zero(n_, k);
-  if (y.size() == 0) y = Eigen::MatrixXd::Zero(m_, k);
-  if (x.rows() != n_ || x.cols() != k || y.rows() != m_ || y.cols() != k) {
+  // Empty warm starts are zero; the kernels set them where they keep the iterate.
+  if ((x.size() != 0 && (x.rows() != n_ || x.cols() != k)) || (y.size() != 0 && (y.rows() != m_ || y.cols() != k))) {
     throwUsage("ADMM: warm starts x and y must be n x k and m x k");
   }
 

@@ -176,7 +176,9 @@ class AdmmKernels {
   /// C's values from new scales (scaling.scaleCount of them, checked by the caller); as
   /// setConstraintValues, K changes at the next setRho.
   virtual void setConstraintScales(std::span<const double> scales) = 0;
-  /// Load q (n x k), bounds (m x k) and warm starts; z = clamp(C x, l, u), xTilde = x.
+  /// Load q (n x k), bounds (m x k) and warm starts x (n x k) and y (m x k), each of which
+  /// may be empty for zero (set where the kernels keep the iterate: nothing copied to a
+  /// device); z = clamp(C x, l, u), xTilde = x.
   virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                      const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
   /// `count` ADMM iterations (OSQP Algorithm 1, with the current rho):

@@ -456,6 +456,30 @@ TEST_F(VulkanAdmm, SmallProblemsRunInOneWorkgroupAndWideOnesRefuseIt) {
   }
 }
 
+TEST_F(VulkanAdmm, EmptyWarmStartsAreZeroesSetOnTheDeviceWithoutACopy) {
+  BoxQp zeros = randomBoxQp(24, 18, 9);
+  zeros.x = Eigen::MatrixXd::Zero(24, 3);
+  zeros.y = Eigen::MatrixXd::Zero(18, 3);
+  BoxQp empty = zeros;
+  empty.x.resize(0, 0);
+  empty.y.resize(0, 0);
+  const compute::AdmmSettings settings = tightSettings();
+  auto given = deviceSolver(context(), zeros, settings, kRecordings[1]);
+  auto unset = deviceSolver(context(), empty, settings, kRecordings[1]);
+  const vk::TransferCounts start = context().transfers();
+  const AdmmRun withZeros = runAdmm(*given, zeros);
+  const vk::TransferCounts middle = context().transfers();
+  const AdmmRun withEmpty = runAdmm(*unset, empty);
+  const vk::TransferCounts end = context().transfers();
+  EXPECT_EQ(withEmpty.info.iterations, withZeros.info.iterations);
+  EXPECT_EQ(withEmpty.x, withZeros.x);
+  EXPECT_EQ(withEmpty.y, withZeros.y);
+  // The same copies but for the two warm starts.
+  EXPECT_EQ((middle.uploads - start.uploads) - (end.uploads - middle.uploads), 2u);
+  EXPECT_EQ((middle.uploadedBytes - start.uploadedBytes) - (end.uploadedBytes - middle.uploadedBytes),
+            sizeof(double) * (24 * 3 + 18 * 3));
+}
+
 // --- The polish on the device (AdmmKernels::refineActiveSet) ------------------------------
 
 /// The equality-constrained QP the polish converges to, by a dense KKT solve:

@@ -210,6 +210,9 @@ struct AdmmKernels::Workspace {
   std::unique_ptr<Multigrid::Binding> cycleResidual, cycleRhs;
   std::unique_ptr<DescriptorSet> rzSet;
   Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
+  /// The same after zeroing x, y or both (an empty warm start: nothing uploaded), by
+  /// (zero x) + 2 (zero y), recorded on first use.
+  std::unique_ptr<Sequence> zeroStarts[4];
   Sequence check;  ///< The inf-norms of AdmmMeasures.
   /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
   /// single-workgroup by 8192 * iteration count + dispatch count.
@@ -521,10 +524,7 @@ void AdmmKernels::prepare(std::uint32_t k) {
   }
 
   w.start.begin();
-  la.spmv(w.start, devC_, w.x, w.zTilde);
-  la.clamp(w.start, w.zTilde, w.lower, w.upper, w.z);
-  la.copy(w.start, w.x, w.xTilde);
-  la.copy(w.start, w.y, w.yPrevious);
+  recordStart(w.start, false, false);
   w.start.end();
 
   Sequence& s = w.check;
@@ -551,6 +551,19 @@ void AdmmKernels::prepare(std::uint32_t k) {
   s.barrier();
   la.reduce(s, w.measures, kSupport);
   s.end();
+}
+
+void AdmmKernels::recordStart(Sequence& s, bool zeroX, bool zeroY) {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  const auto bytes = [](const DeviceVectors& v) { return std::size_t{v.n()} * v.m() * sizeof(double); };
+  if (zeroX) s.zero(w.x.data(), bytes(w.x));
+  if (zeroY) s.zero(w.y.data(), bytes(w.y));
+  if (zeroX || zeroY) s.barrier();
+  la.spmv(s, devC_, w.x, w.zTilde);
+  la.clamp(s, w.zTilde, w.lower, w.upper, w.z);
+  la.copy(s, w.x, w.xTilde);
+  la.copy(s, w.y, w.yPrevious);
 }
 
 void AdmmKernels::recordRightHandSide(Sequence& s) {
@@ -722,8 +735,10 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   w.q.upload(q);
   w.lower.upload(lower);
   w.upper.upload(upper);
-  w.x.upload(x);
-  w.y.upload(y);
+  const bool zeroX = x.size() == 0;
+  const bool zeroY = y.size() == 0;
+  if (!zeroX) w.x.upload(x);
+  if (!zeroY) w.y.upload(y);
   const double zeros[kStateSize] = {};
   w.state.upload(zeros);
   w.innerIterationsSeen = 0.0;
@@ -731,7 +746,18 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   w.polishStartSaved = false;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
-  w.start.run();
+  if (zeroX || zeroY) {
+    auto& sequence = w.zeroStarts[(zeroX ? 1 : 0) + (zeroY ? 2 : 0)];
+    if (!sequence) {
+      sequence = std::make_unique<Sequence>(context_);
+      sequence->begin();
+      recordStart(*sequence, zeroX, zeroY);
+      sequence->end();
+    }
+    sequence->run();
+  } else {
+    w.start.run();
+  }
 }
 
 void AdmmKernels::setLinearTolerance(double tolerance) {
@@ -792,7 +818,9 @@ compute::AdmmMeasures AdmmKernels::measure() {
 }
 
 void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
-  if (!workspace_) {
+  if (!workspace_) {  // k = 0
+    x.resize(n_, 0);
+    y.resize(m_, 0);
     z.resize(m_, 0);
     return;
   }
@@ -800,8 +828,6 @@ void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::Matrix
   workspace_->y.download(y);
   workspace_->z.download(z);
 }
-
-
 
 void AdmmKernels::recordPolish() {
   Workspace& w = *workspace_;

@@ -125,6 +125,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
   void assembleK1(const std::vector<double>& rowScales);
   void assembleK(double rho);
+  /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after zeroing x and/or y.
+  void recordStart(Sequence& s, bool zeroX, bool zeroY);
   void recordRightHandSide(Sequence& s);
   void recordInnerSolve(Sequence& s, int innerIterations);
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);

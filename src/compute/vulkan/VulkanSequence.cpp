@@ -97,6 +97,12 @@ void Sequence::copy(const Buffer& source, const Buffer& destination, std::size_t
   vkCmdCopyBuffer(commands_, source.handle(), destination.handle(), 1, &region);
 }
 
+void Sequence::zero(const Buffer& buffer, std::size_t bytes) {
+  if (!recording_) throwDevice("Vulkan: buffer fill outside begin()/end()");
+  if (bytes == 0) return;  // as for copies
+  vkCmdFillBuffer(commands_, buffer.handle(), 0, bytes, 0u);
+}
+
 void Sequence::end() {
   // Device writes must be visible to host reads of mapped memory after the fence.
   auto memory = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);

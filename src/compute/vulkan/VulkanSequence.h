@@ -49,6 +49,8 @@ class Sequence {
   void barrier();
   void copy(const Buffer& source, const Buffer& destination, std::size_t bytes, std::size_t sourceOffset = 0,
             std::size_t destinationOffset = 0);
+  /// Zero the first `bytes` bytes (a multiple of 4) of `buffer` on the device.
+  void zero(const Buffer& buffer, std::size_t bytes);
   /// Finish recording (writes the end timestamp and a host-visibility barrier).
   void end();
 
