@@ -4,8 +4,8 @@
 // Vulkan compute shaders. Algorithms never branch on the backend.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>

@@ -12,8 +12,10 @@
 // `adaptiveRhoFactor`). The iteration itself is the backend's (Backend::createAdmmSolver,
 // compute/Admm.h): on the CPU the Eigen loop with a prefactored Cholesky, on Vulkan the
 // whole loop on the device. A converged (or solved-inaccurate) solution is then polished
-// here, on the host, by re-solving with the active bounds as equalities, which removes the
-// ADMM's residual tolerance from the answer.
+// by re-solving with the active bounds as equalities, which removes the ADMM's residual
+// tolerance from the answer: the active sets and the acceptance here, the refinements where
+// the ADMM's kernels keep the iterate (compute::AdmmKernels::refineActiveSet: the device's),
+// else here on the host.
 //
 // A problem whose rows are all equalities (l = u: the global step's ε = 0 attempts) needs
 // no ADMM at all: the polish's solve with every row active is its exact solution, so it is
