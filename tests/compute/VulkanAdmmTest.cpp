@@ -480,6 +480,39 @@ TEST_F(VulkanAdmm, EmptyWarmStartsAreZeroesSetOnTheDeviceWithoutACopy) {
             sizeof(double) * (24 * 3 + 18 * 3));
 }
 
+TEST_F(VulkanAdmm, AStartWithTheLastStartsQUploadsTheRestOnly) {
+  // The ε schedule's attempts: one q, wider bounds.
+  const BoxQp qp = randomBoxQp(24, 18, 9);
+  vk::AdmmKernels kernels(context(), qp.P, qp.C, tightSettings(), vk::AdmmRecording::SingleWorkgroup);
+  kernels.setRho(std::vector<char>(18, 0), 0.1);
+  const Eigen::MatrixXd wider = qp.upper.array() + 0.5;
+  const auto uploadsOfStart = [&](const Eigen::MatrixXd& q) {
+    const vk::TransferCounts before = context().transfers();
+    kernels.start(q, qp.lower, wider, qp.x, qp.y);
+    const vk::TransferCounts after = context().transfers();
+    return std::pair{after.uploads - before.uploads, after.uploadedBytes - before.uploadedBytes};
+  };
+  uploadsOfStart(qp.q);
+  const auto same = uploadsOfStart(qp.q);
+  const auto other = uploadsOfStart(qp.q * 2.0);
+  EXPECT_EQ(other.first - same.first, 1u);
+  EXPECT_EQ(other.second - same.second, sizeof(double) * 24 * 3);
+  // The kept q (the last start's) is the one solved with: the same iterate as a fresh start's.
+  const Eigen::MatrixXd q = qp.q * 2.0;
+  kernels.start(q, qp.lower, qp.upper, qp.x, qp.y);
+  kernels.iterate(10);
+  Eigen::MatrixXd x, y, z;
+  kernels.download(x, y, z);
+  vk::AdmmKernels fresh(context(), qp.P, qp.C, tightSettings(), vk::AdmmRecording::SingleWorkgroup);
+  fresh.setRho(std::vector<char>(18, 0), 0.1);
+  fresh.start(q, qp.lower, qp.upper, qp.x, qp.y);
+  fresh.iterate(10);
+  Eigen::MatrixXd xFresh, yFresh, zFresh;
+  fresh.download(xFresh, yFresh, zFresh);
+  EXPECT_EQ(x, xFresh);
+  EXPECT_EQ(y, yFresh);
+}
+
 // --- The polish on the device (AdmmKernels::refineActiveSet) ------------------------------
 
 /// The equality-constrained QP the polish converges to, by a dense KKT solve:

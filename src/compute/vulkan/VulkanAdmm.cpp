@@ -232,6 +232,7 @@ struct AdmmKernels::Workspace {
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
+  Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
 };
 
 AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
@@ -732,7 +733,13 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
   }
   prepare(k);
   Workspace& w = *workspace_;
-  w.q.upload(q);
+  // The attempts of one global step's ε schedule solve with one q (only the bounds widen):
+  // the device keeps it (nothing else writes w.q).
+  if (!(w.uploadedQ.rows() == q.rows() && w.uploadedQ.cols() == q.cols() && w.uploadedQ == q)) {
+    w.uploadedQ.resize(0, 0);  // an upload that throws leaves nothing claimed
+    w.q.upload(q);
+    w.uploadedQ = q;
+  }
   w.lower.upload(lower);
   w.upper.upload(upper);
   const bool zeroX = x.size() == 0;
