@@ -245,8 +245,39 @@ void AdmmSolver::setRho(double rho) {
   rho_ = rho;
 }
 
+Eigen::MatrixXd RelaxedBounds::widened(double offset) const {
+  if (relaxed.size() != static_cast<std::size_t>(centre.rows())) {
+    throwUsage("relaxed bounds: " + std::to_string(relaxed.size()) + " row flags for a centre of " +
+               std::to_string(centre.rows()) + " rows");
+  }
+  Eigen::MatrixXd bound = centre;
+  for (Eigen::Index r = 0; r < bound.rows(); ++r) {
+    if (relaxed[static_cast<std::size_t>(r)]) bound.row(r).array() += offset;
+  }
+  return bound;
+}
+
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                            Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
+  return solve(q, lower, upper, nullptr, x, y, z);
+}
+
+AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds, Eigen::MatrixXd& x,
+                           Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
+  if (bounds.centre.rows() != m_ || bounds.centre.cols() != q.cols() ||
+      bounds.relaxed.size() != static_cast<std::size_t>(m_)) {
+    throwUsage("ADMM: relaxed bounds need an m x k centre and one flag per row");
+  }
+  if (!(bounds.epsilon >= 0.0) || !std::isfinite(bounds.epsilon)) {
+    throwUsage("ADMM: the bounds' relaxation must be finite and >= 0");
+  }
+  // l and u formed here serve the checks below; only the kernels' start takes the relaxation.
+  return solve(q, bounds.lower(), bounds.upper(), &bounds, x, y, z);
+}
+
+AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                           const RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                           Eigen::MatrixXd& z) {
   const Eigen::Index k = q.cols();
   if (q.rows() != n_ || lower.rows() != m_ || upper.rows() != m_ || lower.cols() != k || upper.cols() != k) {
     throwUsage("ADMM: q, lower and upper must be n x k, m x k, m x k");
@@ -267,7 +298,11 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
     factoredRho_ = rho_;
     ++info.factorizations;
   }
-  kernels_->start(q, lower, upper, x, y);
+  if (relaxed) {
+    kernels_->startRelaxed(q, *relaxed, x, y);
+  } else {
+    kernels_->start(q, lower, upper, x, y);
+  }
 
   // Residuals, tolerances and the rho balance at the current iterate. Returns true when converged.
   AdmmMeasures s;

@@ -126,6 +126,23 @@ void checkConstraintScaling(const ConstraintScaling& scaling, Eigen::Index nonZe
 /// `values`, one per stored entry, in C's compressed order.
 void fillScaledValues(const ConstraintScaling& scaling, std::span<const double> scales, double* values);
 
+/// Bounds l <= C x <= u given as a centre widened by epsilon on some rows (the projective
+/// global steps' ε relaxation, paper §4.2): l = centre - epsilon and u = centre + epsilon on
+/// the rows flagged `relaxed`, l = u = centre on the others. Kernels that keep the iterate on
+/// a device form l and u there from a centre they keep (AdmmKernels::startRelaxed): the
+/// attempts of an ε schedule, which share the centre and the flags, upload no bounds.
+struct RelaxedBounds {
+  Eigen::MatrixXd centre;      ///< m x k.
+  std::vector<char> relaxed;   ///< m flags.
+  double epsilon = 0.0;        ///< >= 0.
+  /// l and u; Error(Usage) unless there is one flag per row of the centre.
+  Eigen::MatrixXd lower() const { return widened(-epsilon); }
+  Eigen::MatrixXd upper() const { return widened(epsilon); }
+
+ private:
+  Eigen::MatrixXd widened(double offset) const;
+};
+
 /// Per-column inf-norms at the current iterate (vectors of k entries); all a check needs.
 /// dy = y - y at the start of the last iteration (zero before the first iteration).
 struct AdmmMeasures {
@@ -181,6 +198,12 @@ class AdmmKernels {
   /// device); z = clamp(C x, l, u), xTilde = x.
   virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                      const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
+  /// start() with l and u given as a relaxation (RelaxedBounds, checked by the caller). The
+  /// default forms them on the host; kernels that keep the iterate on a device form them there.
+  virtual void startRelaxed(const Eigen::MatrixXd& q, const RelaxedBounds& bounds, const Eigen::MatrixXd& x,
+                            const Eigen::MatrixXd& y) {
+    start(q, bounds.lower(), bounds.upper(), x, y);
+  }
   /// `count` ADMM iterations (OSQP Algorithm 1, with the current rho):
   ///   xTilde = K^-1 (sigma x - q + C^T (rho z - y))   (warm-started at the last xTilde)
   ///   zTilde = C xTilde
@@ -225,6 +248,12 @@ class AdmmSolver {
   AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                  Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
 
+  /// The same with the bounds as a relaxation (RelaxedBounds: centre m x k, one flag per
+  /// row, epsilon finite and >= 0, else Error(Usage)), which the kernels form where they
+  /// keep the iterate.
+  AdmmInfo solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                 Eigen::MatrixXd& z);
+
   /// New values of C on its pattern (a loop whose constraints change values only, as the
   /// projective global step's with each local step's scale factors): the next solve forms
   /// K again, keeping everything that depends on the pattern. Throws Error(Usage) when C's
@@ -252,6 +281,10 @@ class AdmmSolver {
   double rho() const { return rho_; }
 
  private:
+  /// Both solves': `relaxed` (when not null) is the bounds' form to hand the kernels.
+  AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                 const RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
+
   std::unique_ptr<AdmmKernels> kernels_;
   Eigen::Index n_;
   Eigen::Index m_;

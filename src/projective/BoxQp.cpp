@@ -80,6 +80,16 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  return solve(q, lower, upper, nullptr, x, y);
+}
+
+BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
+                             Eigen::MatrixXd& y) {
+  return solve(q, bounds.lower(), bounds.upper(), &bounds, x, y);
+}
+
+BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                             const compute::RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
   if (lower.size() > 0 && lower == upper) {
     const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
                         (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
@@ -92,7 +102,8 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
     admm_->setRho(settings_.rho);
   }
   Eigen::MatrixXd z;
-  const compute::AdmmInfo admm = admm_->solve(q, lower, upper, x, y, z);
+  const compute::AdmmInfo admm =
+      relaxed ? admm_->solve(q, *relaxed, x, y, z) : admm_->solve(q, lower, upper, x, y, z);
   BoxQpInfo info;
   info.status = toBoxQpStatus(admm.status);
   info.iterations = admm.iterations;

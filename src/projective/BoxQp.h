@@ -116,6 +116,11 @@ class BoxQpSolver {
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
+  /// The same with the bounds as a relaxation (compute::RelaxedBounds: an ε schedule's
+  /// attempts), which the ADMM forms where it runs.
+  BoxQpInfo solve(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
+                  Eigen::MatrixXd& y);
+
   /// C's values as a scaling of its entries from now on (compute::AdmmSolver::
   /// setConstraintScaling), then new values by their scales: the ADMM forms them where it
   /// runs, and C (its values for those scales) serves the polish here.
@@ -135,6 +140,9 @@ class BoxQpSolver {
     int refinements = 0;
   };
 
+  /// Both solves': `relaxed` (when not null) is the bounds' form to hand the ADMM.
+  BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                  const compute::RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
   /// The direct solve of an all-equality problem (EqualitySolve::Direct) from

@@ -157,22 +157,17 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
   Eigen::MatrixXd x = T;
   bool solved = false;
+  compute::RelaxedBounds bounds{d, std::vector<char>(m), 0.0};
+  for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
   for (double eps : schedule) {
     throwIfCancelled("the global step");
-    Eigen::MatrixXd lower = d;
-    Eigen::MatrixXd upper = d;
-    for (Eigen::Index r = 0; r < m; ++r) {
-      if (!positional[r]) {
-        lower.row(r).array() -= eps;
-        upper.row(r).array() += eps;
-      }
-    }
+    bounds.epsilon = eps;
     // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
     // (its certificate), a poor warm start for the next eps.
     Eigen::MatrixXd xTry = T;
     Eigen::MatrixXd yTry;
     const double startRho = qp.rho();
-    const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
+    const BoxQpInfo qpInfo = qp.solve(q, bounds, xTry, yTry);
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;

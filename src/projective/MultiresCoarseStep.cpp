@@ -171,18 +171,12 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
   Eigen::MatrixXd x = T;
   Eigen::MatrixXd y;
   bool solved = false;
+  compute::RelaxedBounds bounds{d, relaxed, 0.0};
   for (const double eps : schedule) {
-    Eigen::MatrixXd lower = d;
-    Eigen::MatrixXd upper = d;
-    for (Eigen::Index r = 0; r < m; ++r) {
-      if (relaxed[r]) {
-        lower.row(r).array() -= eps;
-        upper.row(r).array() += eps;
-      }
-    }
+    bounds.epsilon = eps;
     Eigen::MatrixXd xTry = x;
     Eigen::MatrixXd yTry = y;
-    const BoxQpInfo qpInfo = qp.solve(q, lower, upper, xTry, yTry);
+    const BoxQpInfo qpInfo = qp.solve(q, bounds, xTry, yTry);
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <functional>
 #include <random>
 
@@ -511,6 +512,93 @@ TEST_F(VulkanAdmm, AStartWithTheLastStartsQUploadsTheRestOnly) {
   fresh.download(xFresh, yFresh, zFresh);
   EXPECT_EQ(x, xFresh);
   EXPECT_EQ(y, yFresh);
+}
+
+/// Bounds around the random QP's boxes' centres, every row but the equalities relaxed.
+compute::RelaxedBounds relaxedBoundsOf(const BoxQp& qp, double epsilon) {
+  compute::RelaxedBounds bounds{(qp.lower + qp.upper) / 2.0, std::vector<char>(qp.C.rows()), epsilon};
+  for (Index i = 0; i < qp.C.rows(); ++i) bounds.relaxed[i] = i % 3 != 0;
+  return bounds;
+}
+
+TEST_F(VulkanAdmm, RelaxedBoundsAndTheTargetsAsWarmStartAreFormedOnTheDeviceGivingTheUploadedStartsIterates) {
+  // The global step's ε schedule: one q, one centre, x started at -q (its targets), the
+  // relaxation growing from attempt to attempt.
+  const BoxQp qp = randomBoxQp(24, 18, 11);
+  for (const Recording& recording : kRecordings) {
+    SCOPED_TRACE(recording.name);
+    vk::AdmmKernels relaxed(context(), qp.P, qp.C, tightSettings(), recording.recording);
+    vk::AdmmKernels uploaded(context(), qp.P, qp.C, tightSettings(), recording.recording);
+    const Eigen::MatrixXd targets = -qp.q;
+    for (const double epsilon : {0.05, 0.5}) {
+      SCOPED_TRACE("epsilon " + std::to_string(epsilon));
+      const compute::RelaxedBounds bounds = relaxedBoundsOf(qp, epsilon);
+      std::vector<char> equality(18);
+      for (Index i = 0; i < 18; ++i) equality[i] = !bounds.relaxed[i];
+      relaxed.setRho(equality, 0.1);
+      uploaded.setRho(equality, 0.1);
+      const vk::TransferCounts before = context().transfers();
+      relaxed.startRelaxed(qp.q, bounds, targets, Eigen::MatrixXd());
+      const vk::TransferCounts after = context().transfers();
+      if (epsilon > 0.05) {
+        // Only the state (with epsilon, a few scalars) crosses: no bound, no warm start, no q.
+        EXPECT_EQ(after.uploads - before.uploads, 1u);
+        EXPECT_LT(after.uploadedBytes - before.uploadedBytes, sizeof(double) * 18 * 3);
+      } else {
+        // q, the centre, the flags and the state; x = -q and y = 0 are set on the device.
+        EXPECT_EQ(after.uploads - before.uploads, 4u);
+        Eigen::MatrixXd x0, y0, z0;
+        relaxed.download(x0, y0, z0);
+        EXPECT_EQ(x0, targets);
+        EXPECT_EQ(y0, Eigen::MatrixXd::Zero(18, 3));
+      }
+      uploaded.start(qp.q, bounds.lower(), bounds.upper(), Eigen::MatrixXd(targets), Eigen::MatrixXd::Zero(18, 3));
+      for (vk::AdmmKernels* kernels : {&relaxed, &uploaded}) kernels->iterate(10);
+      Eigen::MatrixXd x, y, z, xUploaded, yUploaded, zUploaded;
+      relaxed.download(x, y, z);
+      uploaded.download(xUploaded, yUploaded, zUploaded);
+      EXPECT_EQ(x, xUploaded);
+      EXPECT_EQ(y, yUploaded);
+      EXPECT_EQ(z, zUploaded);
+      EXPECT_TRUE((z.array() >= bounds.lower().array() && z.array() <= bounds.upper().array()).all());
+    }
+  }
+}
+
+TEST_F(VulkanAdmm, RelaxedBoundsSolveAsTheirLowerAndUpperOnBothBackendsAndWrongOnesAreUsageErrors) {
+  const BoxQp qp = randomBoxQp(24, 18, 12);
+  const compute::RelaxedBounds bounds = relaxedBoundsOf(qp, 0.2);
+  compute::CpuBackend cpu;
+  for (compute::Backend* backend : std::initializer_list<compute::Backend*>{&cpu, &backend()}) {
+    SCOPED_TRACE(backend->name());
+    auto relaxedSolver = backend->createAdmmSolver(qp.P, qp.C, tightSettings());
+    auto boundsSolver = backend->createAdmmSolver(qp.P, qp.C, tightSettings());
+    AdmmRun relaxed, explicitBounds;
+    relaxed.info = relaxedSolver->solve(qp.q, bounds, relaxed.x, relaxed.y, relaxed.z);
+    explicitBounds.info =
+        boundsSolver->solve(qp.q, bounds.lower(), bounds.upper(), explicitBounds.x, explicitBounds.y, explicitBounds.z);
+    EXPECT_EQ(relaxed.info.status, compute::AdmmStatus::Solved);
+    EXPECT_EQ(relaxed.info.iterations, explicitBounds.info.iterations);
+    EXPECT_EQ(relaxed.info.factorizations, explicitBounds.info.factorizations);
+    EXPECT_EQ(relaxed.x, explicitBounds.x);
+    EXPECT_EQ(relaxed.y, explicitBounds.y);
+
+    compute::RelaxedBounds fewFlags = bounds;
+    fewFlags.relaxed.pop_back();
+    compute::RelaxedBounds negative = bounds;
+    negative.epsilon = -0.1;
+    compute::RelaxedBounds notANumber = bounds;
+    notANumber.epsilon = std::nan("");
+    for (const compute::RelaxedBounds* wrong : {&fewFlags, &negative, &notANumber}) {
+      Eigen::MatrixXd x, y, z;
+      EXPECT_THROW(
+          try { relaxedSolver->solve(qp.q, *wrong, x, y, z); } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Usage);
+            throw;
+          },
+          Error);
+    }
+  }
 }
 
 // --- The polish on the device (AdmmKernels::refineActiveSet) ------------------------------

@@ -30,6 +30,9 @@ struct UpdatePush {
 struct SupportPush {
   std::uint32_t n;
 };
+struct RelaxedBoundsPush {
+  std::uint32_t rows, count, epsilonSlot;
+};
 struct SingleWorkgroupPush {
   std::uint32_t n, m, k, iterations, cap, budget, begin, block;
   double sigma, alpha, tolerance2;
@@ -48,7 +51,8 @@ enum State : std::uint32_t {
   kDone = 0, kInnerIterations, kCappedSolves, kLinearTolerance2, kRemaining, kPhase, kSolveIterations, kStateRz,
   kStateBz = kStateRz + AdmmKernels::kSingleWorkgroupColumns,
   kStateRr = kStateBz + AdmmKernels::kSingleWorkgroupColumns,
-  kStateSize = kStateRr + AdmmKernels::kSingleWorkgroupColumns
+  kStateEpsilon = kStateRr + AdmmKernels::kSingleWorkgroupColumns,  ///< A relaxed start's (admm_relaxed_bounds)
+  kStateSize
 };
 // llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
 // single-workgroup kernel's budget keeps its estimate below half of that.
@@ -185,11 +189,12 @@ struct AdmmKernels::Workspace {
         w(context, m, k, "ADMM rho z - y"),
         Cx(context, m, k, "ADMM C x"),
         dy(context, m, k, "ADMM dy"),
+        centre(context, m, k, "ADMM bound centres"),
+        relaxed(context, std::max<std::uint32_t>(m, 1), MemoryClass::Device, "ADMM relaxed rows"),
         pcg(context, kPcgSlots, k, n, 2 * k),
         measures(context, kMeasureSlots, k, std::max(n, m)),
         state(context, kStateSize, MemoryClass::Device, "PCG control state"),
         arguments(context, 12, MemoryClass::Device, "PCG indirect arguments"),
-        start(context),
         check(context) {}
   std::uint32_t k;
   bool singleWorkgroup = false;
@@ -200,6 +205,8 @@ struct AdmmKernels::Workspace {
   std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
+  DeviceVectors centre;            ///< m x k: a relaxed start's (startRelaxed).
+  Array<std::uint32_t> relaxed;    ///< m flags: a relaxed start's.
   DeviceScalars pcg;
   DeviceScalars measures;
   Array<double> state;
@@ -209,10 +216,9 @@ struct AdmmKernels::Workspace {
   // With the multigrid preconditioner: its cycles z = M r and M rhs (for b.z), and r.z's partial sums.
   std::unique_ptr<Multigrid::Binding> cycleResidual, cycleRhs;
   std::unique_ptr<DescriptorSet> rzSet;
-  Sequence start;  ///< z = clamp(C x, l, u), xTilde = x, yPrevious = y
-  /// The same after zeroing x, y or both (an empty warm start: nothing uploaded), by
-  /// (zero x) + 2 (zero y), recorded on first use.
-  std::unique_ptr<Sequence> zeroStarts[4];
+  /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after what the start's kind forms on
+  /// the device (recordStart), by startKey; recorded on first use.
+  std::map<int, std::unique_ptr<Sequence>> starts;
   Sequence check;  ///< The inf-norms of AdmmMeasures.
   /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
   /// single-workgroup by 8192 * iteration count + dispatch count.
@@ -233,6 +239,8 @@ struct AdmmKernels::Workspace {
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
   Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
+  Eigen::MatrixXd uploadedCentre;         ///< What w.centre holds (skipped likewise).
+  std::vector<char> uploadedRelaxed;      ///< What w.relaxed holds (skipped likewise).
 };
 
 AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const compute::SparseMatrix& C,
@@ -277,6 +285,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       singleWorkgroup_(context, "admm_single_workgroup", kSingleWorkgroupBuffers, sizeof(SingleWorkgroupPush),
                        singleWorkgroupSize(context)),
       dot_(context, "la_dot", 3, sizeof(DotPush)),
+      relaxedBounds_(context, "admm_relaxed_bounds", 5, sizeof(RelaxedBoundsPush)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
@@ -524,10 +533,6 @@ void AdmmKernels::prepare(std::uint32_t k) {
             w.lower.data(), w.upper.data(), w.y.data(), w.yPrevious.data(), w.z.data(), rhoRows_, w.state});
   }
 
-  w.start.begin();
-  recordStart(w.start, false, false);
-  w.start.end();
-
   Sequence& s = w.check;
   s.begin();
   la.spmv(s, devC_, w.x, w.Cx);
@@ -554,13 +559,21 @@ void AdmmKernels::prepare(std::uint32_t k) {
   s.end();
 }
 
-void AdmmKernels::recordStart(Sequence& s, bool zeroX, bool zeroY) {
+void AdmmKernels::recordStart(Sequence& s, StartX xStart, bool zeroY, bool relaxedBounds) {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
   const auto bytes = [](const DeviceVectors& v) { return std::size_t{v.n()} * v.m() * sizeof(double); };
-  if (zeroX) s.zero(w.x.data(), bytes(w.x));
+  // x = -q as 0 - q: nothing of x's last contents (possibly non-finite) enters.
+  if (xStart != StartX::Uploaded) s.zero(w.x.data(), bytes(w.x));
   if (zeroY) s.zero(w.y.data(), bytes(w.y));
-  if (zeroX || zeroY) s.barrier();
+  if (xStart != StartX::Uploaded || zeroY) s.barrier();
+  if (xStart == StartX::NegatedQ) la.axpby(s, -1.0, w.q, 1.0, w.x);
+  if (relaxedBounds) {
+    const std::uint32_t count = m_ * w.k;
+    s.dispatch(relaxedBounds_, {w.centre.data(), w.relaxed, w.state, w.lower.data(), w.upper.data()},
+               RelaxedBoundsPush{std::max<std::uint32_t>(m_, 1), count, kStateEpsilon}, groupsFor(context_, count));
+    s.barrier();
+  }
   la.spmv(s, devC_, w.x, w.zTilde);
   la.clamp(s, w.zTilde, w.lower, w.upper, w.z);
   la.copy(s, w.x, w.xTilde);
@@ -724,12 +737,11 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   return *slot;
 }
 
-void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                        const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
   const auto k = elementCount(q.cols(), "the ADMM's column count");
   if (k == 0) {  // nothing to iterate; measure() reports empty norms
     workspace_.reset();
-    return;
+    return false;
   }
   prepare(k);
   Workspace& w = *workspace_;
@@ -740,31 +752,69 @@ void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, 
     w.q.upload(q);
     w.uploadedQ = q;
   }
-  w.lower.upload(lower);
-  w.upper.upload(upper);
-  const bool zeroX = x.size() == 0;
+  return true;
+}
+
+void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                        const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+  if (!loadLinearTerm(q)) return;
+  workspace_->lower.upload(lower);
+  workspace_->upper.upload(upper);
+  finishStart(q, x, y, false, 0.0);
+}
+
+void AdmmKernels::startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds,
+                               const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+  if (!loadLinearTerm(q)) return;
+  Workspace& w = *workspace_;
+  if (bounds.centre.rows() != m_ || bounds.centre.cols() != q.cols() || bounds.relaxed.size() != m_) {
+    throwUsage("Vulkan ADMM: relaxed bounds need an m x k centre and one flag per row");
+  }
+  // An ε schedule's attempts share the centre and the flags, a loop's steps the flags.
+  if (!(w.uploadedCentre.rows() == bounds.centre.rows() && w.uploadedCentre.cols() == bounds.centre.cols() &&
+        w.uploadedCentre == bounds.centre)) {
+    w.uploadedCentre.resize(0, 0);
+    w.centre.upload(bounds.centre);
+    w.uploadedCentre = bounds.centre;
+  }
+  if (m_ > 0 && w.uploadedRelaxed != bounds.relaxed) {
+    w.uploadedRelaxed.clear();
+    const std::vector<std::uint32_t> flags(bounds.relaxed.begin(), bounds.relaxed.end());
+    w.relaxed.upload(flags);
+    w.uploadedRelaxed = bounds.relaxed;
+  }
+  finishStart(q, x, y, true, bounds.epsilon);
+}
+
+void AdmmKernels::finishStart(const Eigen::MatrixXd& q, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                              bool relaxedBounds, double epsilon) {
+  Workspace& w = *workspace_;
+  StartX xStart = StartX::Uploaded;
+  if (x.size() == 0) {
+    xStart = StartX::Zero;
+  } else if (x.rows() == q.rows() && x.cols() == q.cols() && x == -q) {  // exact: negation rounds nothing
+    xStart = StartX::NegatedQ;
+  }
   const bool zeroY = y.size() == 0;
-  if (!zeroX) w.x.upload(x);
+  if (xStart == StartX::Uploaded) w.x.upload(x);
   if (!zeroY) w.y.upload(y);
-  const double zeros[kStateSize] = {};
-  w.state.upload(zeros);
+  double state[kStateSize] = {};
+  state[kStateEpsilon] = epsilon;
+  w.state.upload(state);
   w.innerIterationsSeen = 0.0;
   w.uploadedTolerance = -1.0;
   w.polishStartSaved = false;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
-  if (zeroX || zeroY) {
-    auto& sequence = w.zeroStarts[(zeroX ? 1 : 0) + (zeroY ? 2 : 0)];
-    if (!sequence) {
-      sequence = std::make_unique<Sequence>(context_);
-      sequence->begin();
-      recordStart(*sequence, zeroX, zeroY);
-      sequence->end();
-    }
-    sequence->run();
-  } else {
-    w.start.run();
+  const int key = static_cast<int>(xStart) + 3 * (zeroY ? 1 : 0) + 6 * (relaxedBounds ? 1 : 0);
+  auto& sequence = w.starts[key];
+  if (!sequence) {
+    sequence = std::make_unique<Sequence>(context_);
+    sequence->begin();
+    recordStart(*sequence, xStart, zeroY, relaxedBounds);
+    sequence->end();
   }
+  sequence->run();
 }
 
 void AdmmKernels::setLinearTolerance(double tolerance) {

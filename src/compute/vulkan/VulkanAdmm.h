@@ -100,8 +100,15 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// (shaders/admm_scaled_values.comp). The host copy of C keeps its pattern only.
   void setConstraintScaling(const compute::ConstraintScaling& scaling) override;
   void setConstraintScales(std::span<const double> scales) override;
+  /// q, the centre and flags of relaxed bounds are uploaded only when they differ from the
+  /// last start's, l and u of relaxed bounds are formed on the device
+  /// (shaders/admm_relaxed_bounds.comp), and so are warm starts that are empty (zero) or,
+  /// for x, equal to -q (the global step's: its targets): an ε schedule's later attempts
+  /// then upload nothing mesh-sized.
   void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
              const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
+  void startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, const Eigen::MatrixXd& x,
+                    const Eigen::MatrixXd& y) override;
   void iterate(int count) override;
   compute::AdmmMeasures measure() override;
   void setLinearTolerance(double tolerance) override;
@@ -125,8 +132,18 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
   void assembleK1(const std::vector<double>& rowScales);
   void assembleK(double rho);
-  /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after zeroing x and/or y.
-  void recordStart(Sequence& s, bool zeroX, bool zeroY);
+  /// How start() sets x: uploaded, zero, or -q (each formed on the device but the first).
+  enum class StartX { Uploaded, Zero, NegatedQ };
+  /// Both starts' first part: the workspace for q's columns, and q (false: no columns,
+  /// nothing to start).
+  bool loadLinearTerm(const Eigen::MatrixXd& q);
+  /// Both starts' last part, after the bounds: the warm starts (uploaded or formed as StartX
+  /// says), the state (with a relaxation's epsilon) and the start recording.
+  void finishStart(const Eigen::MatrixXd& q, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, bool relaxedBounds,
+                   double epsilon);
+  /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after setting x (StartX), zeroing y
+  /// and forming relaxed bounds as asked.
+  void recordStart(Sequence& s, StartX xStart, bool zeroY, bool relaxedBounds);
   void recordRightHandSide(Sequence& s);
   void recordInnerSolve(Sequence& s, int innerIterations);
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);
@@ -175,6 +192,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
+  Pipeline relaxedBounds_;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
