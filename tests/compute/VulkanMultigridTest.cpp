@@ -101,5 +101,45 @@ TEST_F(VulkanMultigrid, OneLevelIsTheExactInverse) {
   EXPECT_LT((K * z - r).norm() / r.norm(), 1e-10);
 }
 
+TEST_F(VulkanMultigrid, ACoarsestLevelSplitAcrossDispatchesIsInvertedOnTheDeviceExactly) {
+  // 64 faces, all 64 blocks (256 rows) on one level: on a CPU device its elimination runs
+  // in several dispatches (each within llvmpipe's loop limit).
+  const auto [K0, K1] = splitK(globalStepMatrices(8));
+  compute::BlockMultigridSettings settings{4};
+  settings.coarsestBlocks = 64;
+  const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), settings);
+  ASSERT_EQ(aggregation.levelCount(), 1);
+  ASSERT_EQ(K0.rows(), 256);
+  const Eigen::MatrixXd r = randomColumns(K0.rows(), 2, 9);
+  for (double rho : {1e-1, 1e3}) {
+    SCOPED_TRACE(rho);
+    const Eigen::MatrixXd z = deviceCycle(context(), aggregation, K0, K1, rho, r);
+    const compute::SparseMatrix K = K0 + K1 * rho;
+    EXPECT_LT((K * z - r).norm() / r.norm(), 1e-10);
+  }
+}
+
+TEST_F(VulkanMultigrid, ACoarsestLevelThatIsNotPositiveDefiniteLeavesItsFailureCode) {
+  const auto [K0, K1] = splitK(globalStepMatrices(4));
+  const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), {4});
+  vk::LinearAlgebra algebra(context());
+  vk::Multigrid multigrid(context(), algebra, aggregation, K0, K0);
+  multigrid.setK1(K1);
+  vk::Array<std::uint32_t> failure(context(), 1, vk::MemoryClass::Host, "failure");
+  for (const auto& [rho, expected] : {std::pair{1e3, ~0u}, std::pair{-1e3, vk::Multigrid::kCoarsestFailure}}) {
+    SCOPED_TRACE(rho);
+    const std::uint32_t none = ~0u;
+    failure.upload({&none, 1});
+    vk::Sequence s(context());
+    s.begin();
+    multigrid.setRho(s, rho, failure);
+    s.end();
+    s.run();
+    std::uint32_t failed = 0;
+    failure.download({&failed, 1});
+    EXPECT_EQ(failed, expected);
+  }
+}
+
 }  // namespace
 }  // namespace plano::test

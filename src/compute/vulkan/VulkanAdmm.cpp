@@ -366,7 +366,6 @@ void AdmmKernels::assembleK1(const std::vector<double>& rowScales) {
   if (multigrid_) multigrid_->setK1(assembly_, k1Values_);
   assembly_.end();
   assembly_.run();
-  if (multigrid_) multigrid_->readCoarsestK1();
 }
 
 void AdmmKernels::assembleK(double rho) {
@@ -393,6 +392,9 @@ void AdmmKernels::assembleK(double rho) {
   }
   if (multigrid_) {
     coarseFailure_.download({&failure, 1});
+    if (failure == Multigrid::kCoarsestFailure) {
+      throwNumerical("ADMM: the coarsest multigrid level of K is not positive definite (nor then is K)");
+    }
     if (failure != noFailure) {
       throwNumerical("ADMM: a diagonal block of a coarse multigrid level of K is not positive definite (nor then is K)");
     }

@@ -1,6 +1,6 @@
 #include "compute/vulkan/VulkanMultigrid.h"
 
-#include <Eigen/Cholesky>
+#include <algorithm>
 #include <string>
 
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
@@ -12,6 +12,27 @@ namespace {
 struct TransferPush {  // mg_restrict, mg_prolong
   std::uint32_t fineRows, coarseRows, m, b;
 };
+struct CoarsestAssemblePush {  // mg_coarsest_assemble
+  std::uint32_t rows, pad;
+  double rho;
+};
+struct CoarsestInvertPush {  // mg_coarsest_invert
+  std::uint32_t rows, begin, end, failureCode;
+};
+
+/// The coarsest inversion's workgroup: on CPU devices every lane pays for every barrier.
+std::uint32_t inversionLanes(const Context& context) {
+  return context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 : 256;
+}
+
+/// Elimination steps per dispatch of an inversion of `rows` rows: llvmpipe ends all loops
+/// of an invocation after 65535 back-edges in total (a step costs each lane about
+/// rows^2 / lanes of them), so CPU devices split it, keeping half that; GPUs run it whole.
+std::uint32_t inversionSteps(const Context& context, std::uint32_t rows, std::uint32_t lanes) {
+  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU) return std::max<std::uint32_t>(rows, 1);
+  const std::uint64_t perStep = (std::uint64_t{rows} * rows + 2 * rows) / lanes + 4;
+  return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(32768 / perStep, 1, std::max<std::uint32_t>(rows, 1)));
+}
 
 /// A's pattern with every stored value 1 (no cancellation when coarsened).
 compute::SparseMatrix ones(const compute::SparseMatrix& A) {
@@ -87,6 +108,9 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       restrict_(context, "mg_restrict", 4, sizeof(TransferPush)),
       prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
+      coarsestAssemble_(context, "mg_coarsest_assemble", 5, sizeof(CoarsestAssemblePush)),
+      coarsestInvert_(context, "mg_coarsest_invert", 2, sizeof(CoarsestInvertPush), inversionLanes(context)),
+      inversionStepsPerDispatch_(1),
       noRows_(context, 1, MemoryClass::Device, "multigrid unused rows") {
   const int L = aggregation_.levelCount();
   const std::vector<compute::SparseMatrix> patternLevels = aggregation_.coarsen(ones(pattern));
@@ -121,11 +145,16 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
                                                         MemoryClass::Device, "multigrid block inverses");
     }
     if (coarsest) {
+      if (level->rows > kMaxCoarsestRows) {
+        throwDevice("Vulkan multigrid: a coarsest level of " + std::to_string(level->rows) + " rows (at most " +
+                    std::to_string(kMaxCoarsestRows) + ")");
+      }
       const compute::SparseMatrix dense = Eigen::MatrixXd::Ones(level->rows, level->rows).sparseView();
       compute::SparseMatrix full = dense;
       full.makeCompressed();
       level->K = std::make_unique<DeviceCsrMatrix>(context, full);
-      coarsestK0_ = k0Levels[l];
+      coarsestK0_ = std::make_unique<DeviceCsrMatrix>(context, onPattern(k0Levels[l], patternLevels[l]));
+      inversionStepsPerDispatch_ = inversionSteps(context, level->rows, inversionLanes(context));
     }
     patterns_.push_back(patternLevels[l]);
     levels_.push_back(std::move(level));
@@ -144,6 +173,7 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
 Multigrid::~Multigrid() = default;
 
 void Multigrid::setK1(Sequence& sequence, const Array<double>& k1) {
+  k1Set_ = true;
   const int L = levelCount();
   if (L == 1) {
     sequence.copy(k1, *coarsestK1Values_, coarsestK1Values_->count() * sizeof(double));
@@ -157,12 +187,6 @@ void Multigrid::setK1(Sequence& sequence, const Array<double>& k1) {
   }
 }
 
-void Multigrid::readCoarsestK1() {
-  coarsestK1_ = patterns_.back();
-  coarsestK1Values_->download({coarsestK1_.valuePtr(), static_cast<std::size_t>(coarsestK1_.nonZeros())});
-  k1Set_ = true;
-}
-
 void Multigrid::setK1(const compute::SparseMatrix& K1) {
   const compute::SparseMatrix values = onPattern(K1, patterns_.front());
   Array<double> k1(context_, static_cast<std::size_t>(values.nonZeros()), MemoryClass::Device, "multigrid K1 values");
@@ -172,7 +196,6 @@ void Multigrid::setK1(const compute::SparseMatrix& K1) {
   setK1(sequence, k1);
   sequence.end();
   sequence.run();
-  readCoarsestK1();
 }
 
 void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure) {
@@ -185,15 +208,18 @@ void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& fai
     sequence.barrier();
     algebra_.invertDiagonalBlocks(sequence, *level.K, block_, *level.inverses, failure);
   }
-  // The coarsest level: a dense inverse from its two small matrices.
-  const Eigen::MatrixXd K = Eigen::MatrixXd(coarsestK0_) + rho * Eigen::MatrixXd(coarsestK1_);
-  const Eigen::LLT<Eigen::MatrixXd> llt(K);
-  if (llt.info() != Eigen::Success || !K.allFinite()) {
-    throwNumerical("ADMM: the coarsest multigrid level of K is not positive definite (nor then is K)");
+  // The coarsest level: its dense inverse, in place of its dense K.
+  const std::uint32_t rows = levels_.back()->rows;
+  Array<double>& dense = levels_.back()->K->values();
+  sequence.dispatch(coarsestAssemble_,
+                    {coarsestK0_->rowOffsets(), coarsestK0_->columns(), coarsestK0_->values(), *coarsestK1Values_, dense},
+                    CoarsestAssemblePush{rows, 0, rho}, groupsFor(context_, rows));
+  sequence.barrier();
+  for (std::uint32_t begin = 0; begin < rows; begin += inversionStepsPerDispatch_) {
+    const std::uint32_t end = std::min(rows, begin + inversionStepsPerDispatch_);
+    sequence.dispatch(coarsestInvert_, {dense, failure}, CoarsestInvertPush{rows, begin, end, kCoarsestFailure}, 1);
+    sequence.barrier();
   }
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse =
-      llt.solve(Eigen::MatrixXd::Identity(K.rows(), K.cols()));
-  levels_.back()->K->values().upload({inverse.data(), static_cast<std::size_t>(inverse.size())});
 }
 
 std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks,

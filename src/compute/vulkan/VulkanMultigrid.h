@@ -9,9 +9,11 @@
 // are a fixed gather of the finer level's (DeviceGather, built once from the patterns).
 // A rho update is then device work only: K_l on every level
 // (admm_assemble) and the block-Jacobi inverses of every level but the coarsest
-// (block_jacobi_inverse); the coarsest level (at most BlockMultigridSettings::coarsestBlocks
-// blocks) is inverted densely on the host from its two small matrices and uploaded, a
-// transfer that does not grow with the mesh.
+// (block_jacobi_inverse), and the coarsest level's dense inverse (at most
+// kMaxCoarsestRows rows): assembled dense from its two small matrices (mg_coarsest_assemble)
+// and inverted in place by Gauss-Jordan in one workgroup (mg_coarsest_invert). Before, the
+// host inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
+// deformation, up to 8 MiB), after downloading the coarsest K1 at each new C.
 //
 // One cycle: on each level, z = S r (block-Jacobi), t = r - K z, restrict t; the coarsest
 // z = K^-1 r; back up, z += Z z_coarse, t = r - K z, z += S t. Every dispatch is sized by
@@ -38,17 +40,22 @@ class Multigrid {
   Multigrid(const Multigrid&) = delete;
   Multigrid& operator=(const Multigrid&) = delete;
 
+  /// Largest coarsest level (rows) inverted on the device: vk::AdmmKernels::kMaxCoarsestBlocks
+  /// blocks of at most 4 rows (shaders/mg_coarsest_invert.comp's shared memory).
+  static constexpr std::uint32_t kMaxCoarsestRows = 1024;
+  /// What setRho leaves in `failure` when the coarsest level is not positive definite.
+  static constexpr std::uint32_t kCoarsestFailure = 0xFFFFFFFEu;
+
   /// Record the coarse levels' K1 from level 0's K1 values (on the caller's `pattern`,
-  /// already on the device); once the sequence ran, readCoarsestK1() fetches the coarsest
-  /// level's values (a small matrix, for its dense inverse at each rho update).
+  /// already on the device); setRho's recordings need the sequence to have run.
   void setK1(Sequence& sequence, const Array<double>& k1);
-  void readCoarsestK1();
-  /// The same from a host matrix on level 0's pattern (uploads it; tests and callers
-  /// without K1 on the device).
+  /// The same from a host matrix on level 0's pattern (uploads it and runs; tests and
+  /// callers without K1 on the device).
   void setK1(const compute::SparseMatrix& K1);
-  /// Record K_l = K0_l + rho K1_l on the coarse levels and the block inverses of levels
-  /// 1 .. L-2 into `sequence` (level 0's are the caller's); upload the coarsest inverse.
-  /// A coarse block that is not positive definite leaves its index in `failure`.
+  /// Record K_l = K0_l + rho K1_l on the coarse levels, the block inverses of levels
+  /// 1 .. L-2 (level 0's are the caller's) and the coarsest level's dense inverse into
+  /// `sequence`. A coarse block that is not positive definite leaves its index in `failure`
+  /// (set to ~0 by the caller), a coarsest level that is not, kCoarsestFailure.
   void setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure);
 
   /// The cycle's level-0 operands: input r, output z, K and its block inverses. Descriptor
@@ -85,11 +92,12 @@ class Multigrid {
   compute::BlockAggregation aggregation_;
   std::vector<compute::SparseMatrix> patterns_;  ///< Level patterns (values 0), levels 1 ..
   std::vector<std::unique_ptr<Level>> levels_;   ///< Levels 0 .. L-1 (level 0 holds only temporaries).
-  compute::SparseMatrix coarsestK0_, coarsestK1_;
   std::vector<std::unique_ptr<DeviceGather>> coarsenings_;  ///< Level l's values -> level l + 1's.
+  std::unique_ptr<DeviceCsrMatrix> coarsestK0_;            ///< The coarsest level's K0, on its pattern.
   std::unique_ptr<Array<double>> coarsestK1Values_;        ///< On the coarsest level's pattern.
   bool k1Set_ = false;
-  Pipeline spmv_, scale_, axpby_, restrict_, prolong_, assemble_;
+  Pipeline spmv_, scale_, axpby_, restrict_, prolong_, assemble_, coarsestAssemble_, coarsestInvert_;
+  std::uint32_t inversionStepsPerDispatch_;
   Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
 };
 
