@@ -156,6 +156,19 @@ std::vector<std::int32_t> transposeTargets(const compute::SparseMatrix& C) {
   return targets;
 }
 
+/// The sequence in `slot`, recorded by `record` on first use (recordings are kept by what
+/// sizes them: a block's iteration count, a start's kind).
+template <class Record>
+Sequence& recordedOnce(std::unique_ptr<Sequence>& slot, Context& context, Record&& record) {
+  if (!slot) {
+    slot = std::make_unique<Sequence>(context);
+    slot->begin();
+    record(*slot);
+    slot->end();
+  }
+  return *slot;
+}
+
 /// A device array holding `values` (at least one element: Vulkan buffers are never empty).
 Array<std::int32_t> uploaded(Context& context, const std::vector<std::int32_t>& values, const char* what) {
   Array<std::int32_t> array(context, std::max<std::size_t>(values.size(), 1), MemoryClass::Device, what);
@@ -697,27 +710,17 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
   const double units = count * (w.expectedInnerIterations + 2.0);
   int dispatches = 1;
   while (dispatches < 4096 && dispatches * static_cast<double>(w.budget) < units) dispatches *= 2;
-  auto& first = w.blocks[count * 8192 + dispatches];
-  if (!first) {
-    first = std::make_unique<Sequence>(context_);
-    first->begin();
-    recordSingleWorkgroup(*first, count, dispatches, true);
-    first->end();
-  }
-  first->run();
+  recordedOnce(w.blocks[count * 8192 + dispatches], context_, [&](Sequence& s) {
+    recordSingleWorkgroup(s, count, dispatches, true);
+  }).run();
   // One read-back per run: the position tells whether the block is done.
   double state[kStateSize];
   w.state.download(state);
   while (state[kRemaining] > 0.0) {
     throwIfCancelled("the ADMM iteration");
-    auto& resume = w.resumes[dispatches];
-    if (!resume) {
-      resume = std::make_unique<Sequence>(context_);
-      resume->begin();
-      recordSingleWorkgroup(*resume, count, dispatches, false);
-      resume->end();
-    }
-    resume->run();
+    recordedOnce(w.resumes[dispatches], context_, [&](Sequence& s) {
+      recordSingleWorkgroup(s, count, dispatches, false);
+    }).run();
     w.state.download(state);
   }
   w.expectedInnerIterations = std::max(1.0, (state[kInnerIterations] - w.innerIterationsSeen) / count);
@@ -727,16 +730,12 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
 Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
-  if (!slot) {
+  return recordedOnce(slot, context_, [&](Sequence& s) {
     const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
-    slot = std::make_unique<Sequence>(context_);
-    slot->begin();
     for (int i = 0; i < count; ++i) {
-      recordIteration(*slot, i == count - 1, i == 0 && longFirstSolve ? largest : innerIterations_);
+      recordIteration(s, i == count - 1, i == 0 && longFirstSolve ? largest : innerIterations_);
     }
-    slot->end();
-  }
-  return *slot;
+  });
 }
 
 bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
@@ -809,14 +808,7 @@ void AdmmKernels::finishStart(const Eigen::MatrixXd& q, const Eigen::MatrixXd& x
   cappedSolves_ = 0;
   longFirstSolve_ = true;
   const int key = static_cast<int>(xStart) + 3 * (zeroY ? 1 : 0) + 6 * (relaxedBounds ? 1 : 0);
-  auto& sequence = w.starts[key];
-  if (!sequence) {
-    sequence = std::make_unique<Sequence>(context_);
-    sequence->begin();
-    recordStart(*sequence, xStart, zeroY, relaxedBounds);
-    sequence->end();
-  }
-  sequence->run();
+  recordedOnce(w.starts[key], context_, [&](Sequence& s) { recordStart(s, xStart, zeroY, relaxedBounds); }).run();
 }
 
 void AdmmKernels::setLinearTolerance(double tolerance) {
