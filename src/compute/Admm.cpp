@@ -225,9 +225,12 @@ void AdmmSolver::setConstraintScales(std::span<const double> scales) {
 
 bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
                                  ActiveSetRefinementInfo& info) {
-  if (request.active.size() != static_cast<std::size_t>(m_) || request.targets.rows() != m_) {
+  const bool bySides = !request.sides.empty();
+  if (request.active.size() != static_cast<std::size_t>(m_) ||
+      (bySides ? request.targets.size() != 0 : request.targets.rows() != m_)) {
     throwUsage("ADMM: an active set of " + std::to_string(request.active.size()) + " rows and targets of " +
-               std::to_string(request.targets.rows()) + " for " + std::to_string(m_) + " constraint rows");
+               std::to_string(request.targets.rows()) + (bySides ? " with sides" : "") + " for " +
+               std::to_string(m_) + " constraint rows");
   }
   bool refined = false;
   try {
@@ -257,27 +260,44 @@ Eigen::MatrixXd RelaxedBounds::widened(double offset) const {
   return bound;
 }
 
+double AdmmKernels::boundViolation() {
+  throwUsage("ADMM: these kernels do not keep the iterate (no bound violation to measure there)");
+}
+
+void AdmmKernels::discardRefinement() {
+  throwUsage("ADMM: these kernels do not keep the iterate (no refinement to discard)");
+}
+
+void AdmmSolver::discardRefinement() {
+  kernels_->discardRefinement();
+}
+
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                            Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
-  return solve(q, lower, upper, nullptr, x, y, z);
+  const AdmmInfo info = iterate(q, lower, upper, nullptr, x, y);
+  kernels_->download(x, y, z);
+  return info;
 }
 
 AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds, Eigen::MatrixXd& x,
                            Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
-  if (bounds.centre.rows() != m_ || bounds.centre.cols() != q.cols() ||
-      bounds.relaxed.size() != static_cast<std::size_t>(m_)) {
-    throwUsage("ADMM: relaxed bounds need an m x k centre and one flag per row");
-  }
-  if (!(bounds.epsilon >= 0.0) || !std::isfinite(bounds.epsilon)) {
-    throwUsage("ADMM: the bounds' relaxation must be finite and >= 0");
-  }
-  // l and u formed here serve the checks below; only the kernels' start takes the relaxation.
-  return solve(q, bounds.lower(), bounds.upper(), &bounds, x, y, z);
+  // l and u formed here serve the checks; only the kernels' start takes the relaxation.
+  const AdmmInfo info = iterate(q, bounds.lower(), bounds.upper(), &bounds, x, y);
+  kernels_->download(x, y, z);
+  return info;
 }
 
-AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                           const RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
-                           Eigen::MatrixXd& z) {
+AdmmInfo AdmmSolver::iterate(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                             const RelaxedBounds* relaxed, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+  if (relaxed) {
+    if (relaxed->centre.rows() != m_ || relaxed->centre.cols() != q.cols() ||
+        relaxed->relaxed.size() != static_cast<std::size_t>(m_)) {
+      throwUsage("ADMM: relaxed bounds need an m x k centre and one flag per row");
+    }
+    if (!(relaxed->epsilon >= 0.0) || !std::isfinite(relaxed->epsilon)) {
+      throwUsage("ADMM: the bounds' relaxation must be finite and >= 0");
+    }
+  }
   const Eigen::Index k = q.cols();
   if (q.rows() != n_ || lower.rows() != m_ || upper.rows() != m_ || lower.cols() != k || upper.cols() != k) {
     throwUsage("ADMM: q, lower and upper must be n x k, m x k, m x k");
@@ -444,7 +464,6 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lowe
   info.rho = rho_;
   info.linearIterations = s.linearIterations;
   info.inexactSolves = s.inexactSolves;
-  kernels_->download(x, y, z);
   return info;
 }
 

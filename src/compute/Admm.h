@@ -157,6 +157,9 @@ struct AdmmMeasures {
   long inexactSolves = 0;          ///< Since start().
 };
 
+/// Which bound the polish holds a row of a column at (AdmmKernels::findActiveSides).
+enum class BoundSide : std::uint8_t { Free, Lower, Upper };
+
 /// The polish's refinements with an active set (projective/BoxQp.h), run where the
 /// iterate lives (AdmmKernels::refineActiveSet).
 struct ActiveSetRefinement {
@@ -166,6 +169,14 @@ struct ActiveSetRefinement {
   double rho = 1e9;                    ///< Penalty of the active rows.
   int maxRefinements = 30;
   double goal = 0.0;                   ///< Stop once the active rows' residual is at most this.
+  /// Instead of targets (then empty): the side of each row of each column (m x k,
+  /// column-major, as findActiveSides gave them); the targets are those bounds, formed where
+  /// the kernels keep them.
+  std::vector<BoundSide> sides;
+  /// Leave the result where the kernels keep the iterate (x and y are not written): the
+  /// caller measures it (boundViolation), keeps it or discards it (discardRefinement), and
+  /// fetches what it keeps with download().
+  bool keepResult = false;
 };
 
 /// What refineActiveSet did.
@@ -218,6 +229,11 @@ class AdmmKernels {
   virtual void setLinearTolerance(double tolerance) { (void)tolerance; }
   /// The current x, y and z (n x k, m x k, m x k).
   virtual void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) = 0;
+  /// x and y only (z serves the host's polish alone).
+  virtual void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+    Eigen::MatrixXd z;
+    download(x, y, z);
+  }
   /// The polish's method of multipliers on the iterate the last iterate() left (or start()
   /// loaded), where these kernels keep it, so that the polish moves no mesh-sized data per
   /// refinement: with K_A = P + sigma I + rho C^T diag(active) C, lambda = y on the active
@@ -234,6 +250,21 @@ class AdmmKernels {
     (void)request, (void)x, (void)y, (void)info;
     return false;
   }
+  /// The polish's active sets at the iterate, found where the kernels keep it, by OSQP's
+  /// rule (projective/BoxQp.cpp's): per row and column (m x k, column-major) Lower where
+  /// l = u or z - l < -y, else Upper where u - z < y, else Free. Returns false when these
+  /// kernels have no such step or no refineActiveSet with sides and keepResult (the caller
+  /// then polishes from download()), and then also the three below are not available.
+  virtual bool findActiveSides(std::vector<BoundSide>& sides) {
+    (void)sides;
+    return false;
+  }
+  /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN when C x is
+  /// not finite.
+  virtual double boundViolation();
+  /// Make the iterate the one the last refineActiveSet started from (the ADMM's), after a
+  /// refinement with keepResult that the caller rejects.
+  virtual void discardRefinement();
 };
 
 /// The ADMM control logic over a backend's kernels (see the file comment).
@@ -247,6 +278,13 @@ class AdmmSolver {
   /// equality pattern or rho changed.
   AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                  Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
+  /// solve() without fetching the iterate: it stays where the kernels keep it, for the
+  /// polish's steps below, until download(). `relaxed`, when not null, is the bounds' form
+  /// the kernels start from (lower and upper must be its l and u).
+  AdmmInfo iterate(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                   const RelaxedBounds* relaxed, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y);
+  void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) { kernels_->download(x, y, z); }
+  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) { kernels_->downloadSolution(x, y); }
 
   /// The same with the bounds as a relaxation (RelaxedBounds: centre m x k, one flag per
   /// row, epsilon finite and >= 0, else Error(Usage)), which the kernels form where they
@@ -270,6 +308,10 @@ class AdmmSolver {
   /// none. The next solve forms K again.
   bool refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
                        ActiveSetRefinementInfo& info);
+  /// AdmmKernels::findActiveSides, boundViolation and discardRefinement on the iterate.
+  bool findActiveSides(std::vector<BoundSide>& sides) { return kernels_->findActiveSides(sides); }
+  double boundViolation() { return kernels_->boundViolation(); }
+  void discardRefinement();
 
   /// The rho the next solve starts at (by default the last solve's final rho): a caller
   /// rewinds it after a solve whose rho ran off (projective/GlobalStep.cpp). Throws
@@ -281,10 +323,6 @@ class AdmmSolver {
   double rho() const { return rho_; }
 
  private:
-  /// Both solves': `relaxed` (when not null) is the bounds' form to hand the kernels.
-  AdmmInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                 const RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z);
-
   std::unique_ptr<AdmmKernels> kernels_;
   Eigen::Index n_;
   Eigen::Index m_;

@@ -101,9 +101,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
     // PCG iterations in its solves with K, which that rho made stiffer (4.8 -> 2.5 s).
     admm_->setRho(settings_.rho);
   }
-  Eigen::MatrixXd z;
-  const compute::AdmmInfo admm =
-      relaxed ? admm_->solve(q, *relaxed, x, y, z) : admm_->solve(q, lower, upper, x, y, z);
+  const compute::AdmmInfo admm = admm_->iterate(q, lower, upper, relaxed, x, y);
   BoxQpInfo info;
   info.status = toBoxQpStatus(admm.status);
   info.iterations = admm.iterations;
@@ -112,12 +110,56 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   info.primalResidual = admm.primalResidual;
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
-  if (isSolved(info.status) && settings_.polish && info.iterations > 0) {
-    info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
+  const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
+  if (polishing && polishInPlace(lower, upper, info)) {
+    admm_->downloadSolution(x, y);
+  } else {
+    Eigen::MatrixXd z;
+    admm_->download(x, y, z);
+    if (polishing) info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
   }
   info.maxBoundViolation = boundViolation(C_ * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
   return info;
+}
+
+bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info) {
+  std::vector<compute::BoundSide> sides;
+  if (!admm_->findActiveSides(sides)) return false;
+  const Eigen::Index m = C_.rows();
+  const Eigen::Index k = lower.cols();
+  std::vector<char> active(m);
+  for (Eigen::Index i = 0; i < m; ++i) active[i] = sides[i] != compute::BoundSide::Free;
+  double largestTarget = 0.0;
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const compute::BoundSide side = sides[c * m + i];
+      // Columns with other active sets need a refinement each, merged on the host (polish).
+      if ((side != compute::BoundSide::Free) != static_cast<bool>(active[i])) return false;
+      if (side == compute::BoundSide::Lower) largestTarget = std::max(largestTarget, std::abs(lower(i, c)));
+      if (side == compute::BoundSide::Upper) largestTarget = std::max(largestTarget, std::abs(upper(i, c)));
+    }
+  }
+  std::vector<Eigen::Index> columns(k);
+  for (Eigen::Index c = 0; c < k; ++c) columns[c] = c;
+  compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho,
+                                       settings_.polishIterations, kRoundingGoal * std::max(1.0, largestTarget),
+                                       std::move(sides), true};
+  const double before = admm_->boundViolation();
+  compute::ActiveSetRefinementInfo refined;
+  Eigen::MatrixXd unusedX, unusedY;
+  if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) return false;
+  info.polishRefinements += refined.refinements;
+  // Not factored: the ADMM's solution stands (the iterate is untouched). A refinement that
+  // leaves the bounds more violated (or non-finite: NaN fails the test) is discarded.
+  if (!refined.factored) return true;
+  const double after = admm_->boundViolation();
+  if (!(after <= std::max(before, 1e-12))) {
+    admm_->discardRefinement();
+    return true;
+  }
+  info.polished = true;
+  return true;
 }
 
 bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -164,7 +206,7 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
     }
     // Where the ADMM's kernels keep the iterate (the device), they refine it there.
     compute::ActiveSetRefinement request{active[first], targets, columns, settings_.polishRho,
-                                         settings_.polishIterations, 0.0};
+                                         settings_.polishIterations, 0.0, {}, false};
     double largestTarget = 0.0;
     for (const Eigen::Index c : columns) {
       for (Eigen::Index i = 0; i < m; ++i) {

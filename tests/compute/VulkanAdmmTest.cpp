@@ -655,7 +655,7 @@ TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMo
     ASSERT_GT(bounds, 0) << "no inequality row active: the case tests equalities only";
     // rho milder than the polish's 1e9: this random P with Jacobi blocks would need thousands of
     // PCG iterations per solve there, and the solution is the same.
-    const compute::ActiveSetRefinement request{active, targets, {0}, 1e6, 30, 1e-15};
+    const compute::ActiveSetRefinement request{active, targets, {0}, 1e6, 30, 1e-15, {}, false};
     Eigen::MatrixXd xReference, yReference;
     activeSetReference(qp, active, targets, xReference, yReference);
 
@@ -689,13 +689,94 @@ TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMo
   }
 }
 
+/// The polish's active sides by its rule (projective/BoxQp.cpp) on a downloaded iterate.
+std::vector<compute::BoundSide> hostSides(const BoxQp& qp, const Eigen::MatrixXd& z, const Eigen::MatrixXd& y) {
+  std::vector<compute::BoundSide> sides;
+  for (Index c = 0; c < z.cols(); ++c) {
+    for (Index i = 0; i < z.rows(); ++i) {
+      const double l = qp.lower(i, c), u = qp.upper(i, c);
+      sides.push_back(l == u || z(i, c) - l < -y(i, c) ? compute::BoundSide::Lower
+                      : u - z(i, c) < y(i, c)          ? compute::BoundSide::Upper
+                                                       : compute::BoundSide::Free);
+    }
+  }
+  return sides;
+}
+
+TEST_F(VulkanAdmm, ThePolishFindsItsActiveSidesAndKeepsItsResultOnTheDeviceAsTheHostWouldWithTargets) {
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  const compute::AdmmSettings settings;
+  const Recording& recording = kRecordings[1];
+  auto bySides = deviceSolver(context(), qp, settings, recording);
+  auto byTargets = deviceSolver(context(), qp, settings, recording);
+  const AdmmRun admm = runAdmm(*bySides, qp);
+  runAdmm(*byTargets, qp);
+  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+
+  // The sides, found on the device: the host's rule on the downloaded iterate, for a sixteenth
+  // of a vector's bytes.
+  std::vector<compute::BoundSide> sides;
+  vk::TransferCounts before = context().transfers();
+  ASSERT_TRUE(bySides->findActiveSides(sides));
+  vk::TransferCounts after = context().transfers();
+  EXPECT_EQ(sides, hostSides(qp, admm.z, admm.y));
+  EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, sizeof(std::uint32_t) * ((24 * 3 + 15) / 16));
+  // The bound violation at x: the host's on the downloaded x.
+  const Eigen::MatrixXd Cx = qp.C * admm.x;
+  const double hostViolation = std::max({0.0, (qp.lower - Cx).maxCoeff(), (Cx - qp.upper).maxCoeff()});
+  EXPECT_NEAR(bySides->boundViolation(), hostViolation, 1e-13 * std::max(1.0, Cx.cwiseAbs().maxCoeff()));
+
+  // One active set for every column (column 0's), each column held at its own sides there.
+  std::vector<char> active(24);
+  for (Index i = 0; i < 24; ++i) active[i] = sides[i] != compute::BoundSide::Free;
+  std::vector<compute::BoundSide> shared(24 * 3);
+  Eigen::MatrixXd targets = Eigen::MatrixXd::Zero(24, 3);
+  for (Index c = 0; c < 3; ++c) {
+    for (Index i = 0; i < 24; ++i) {
+      const bool upper = active[i] && sides[c * 24 + i] == compute::BoundSide::Upper;
+      shared[c * 24 + i] = !active[i] ? compute::BoundSide::Free
+                           : upper    ? compute::BoundSide::Upper
+                                      : compute::BoundSide::Lower;
+      if (active[i]) targets(i, c) = upper ? qp.upper(i, c) : qp.lower(i, c);
+    }
+  }
+  compute::ActiveSetRefinement request{active, targets, {0, 1, 2}, 1e6, 30, 1e-15, {}, false};
+  Eigen::MatrixXd xTargets, yTargets;
+  compute::ActiveSetRefinementInfo infoTargets;
+  ASSERT_TRUE(byTargets->refineActiveSet(request, xTargets, yTargets, infoTargets));
+
+  request.targets.resize(0, 0);
+  request.sides = shared;
+  request.keepResult = true;
+  Eigen::MatrixXd untouched = Eigen::MatrixXd::Constant(2, 2, 7.0), alsoUntouched = untouched;
+  compute::ActiveSetRefinementInfo info;
+  before = context().transfers();
+  ASSERT_TRUE(bySides->refineActiveSet(request, untouched, alsoUntouched, info));
+  after = context().transfers();
+  EXPECT_EQ(untouched, Eigen::MatrixXd::Constant(2, 2, 7.0));
+  EXPECT_EQ(alsoUntouched, Eigen::MatrixXd::Constant(2, 2, 7.0));
+  EXPECT_EQ(info.refinements, infoTargets.refinements);
+  // Up: the sides (other than the ones found), the flags and a few scalars; no targets.
+  EXPECT_LE(after.uploadedBytes - before.uploadedBytes, sizeof(std::uint32_t) * 5 + sizeof(double) * 24 + 64);
+  Eigen::MatrixXd x, y;
+  bySides->downloadSolution(x, y);
+  EXPECT_EQ(x, xTargets);
+  EXPECT_EQ(y, yTargets);
+
+  // Discarded, the iterate is the ADMM's again.
+  bySides->discardRefinement();
+  bySides->downloadSolution(x, y);
+  EXPECT_EQ(x, admm.x);
+  EXPECT_EQ(y, admm.y);
+}
+
 TEST_F(VulkanAdmm, HostKernelsLeaveThePolishToTheCallerAndWrongActiveSetsAreUsageErrors) {
   const BoxQp qp = randomBoxQp(24, 18, 5);
   compute::CpuBackend cpu;
   const compute::AdmmSettings settings;
   auto host = cpu.createAdmmSolver(qp.P, qp.C, settings);
   runAdmm(*host, qp);
-  const compute::ActiveSetRefinement request{std::vector<char>(18, 1), qp.lower, {0, 1, 2}, 1e9, 30, 1e-15};
+  const compute::ActiveSetRefinement request{std::vector<char>(18, 1), qp.lower, {0, 1, 2}, 1e9, 30, 1e-15, {}, false};
   Eigen::MatrixXd x, y;
   compute::ActiveSetRefinementInfo info;
   EXPECT_FALSE(host->refineActiveSet(request, x, y, info));  // BoxQpSolver refines on the host
@@ -710,6 +791,19 @@ TEST_F(VulkanAdmm, HostKernelsLeaveThePolishToTheCallerAndWrongActiveSetsAreUsag
   wrong = request;
   wrong.columns = {3};
   EXPECT_THROW(device->refineActiveSet(wrong, x, y, info), Error);
+  wrong = request;
+  wrong.targets.resize(0, 0);
+  wrong.sides.assign(17 * 3, compute::BoundSide::Free);
+  EXPECT_THROW(device->refineActiveSet(wrong, x, y, info), Error);
+
+  // Sides, violations and discarding belong to kernels that keep the iterate, and a discard
+  // to a refinement.
+  std::vector<compute::BoundSide> sides;
+  EXPECT_FALSE(host->findActiveSides(sides));
+  EXPECT_THROW(host->boundViolation(), Error);
+  EXPECT_THROW(host->discardRefinement(), Error);
+  runAdmm(*device, qp);
+  EXPECT_THROW(device->discardRefinement(), Error);
 }
 
 // --- A real global-step QP, captured from a CPU global step ------------------------------

@@ -33,6 +33,15 @@ struct SupportPush {
 struct RelaxedBoundsPush {
   std::uint32_t rows, count, epsilonSlot;
 };
+
+/// Words of `entries` active sides packed sixteen to a word (admm_active_sides).
+std::size_t sideWords(std::size_t entries) { return (entries + 15) / 16; }
+
+std::vector<std::uint32_t> packSides(const std::vector<compute::BoundSide>& sides) {
+  std::vector<std::uint32_t> words(sideWords(sides.size()), 0u);
+  for (std::size_t e = 0; e < sides.size(); ++e) words[e / 16] |= static_cast<std::uint32_t>(sides[e]) << (2 * (e % 16));
+  return words;
+}
 struct SingleWorkgroupPush {
   std::uint32_t n, m, k, iterations, cap, budget, begin, block;
   double sigma, alpha, tolerance2;
@@ -43,7 +52,9 @@ struct SingleWorkgroupPush {
 enum PcgSlot : std::uint32_t { kRzEven = 0, kRrEven, kRzOdd, kRrOdd, kPq, kBz, kPcgSlots };
 // Check scalar slots (k values each), in AdmmMeasures' order.
 enum MeasureSlot : std::uint32_t {
-  kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
+  kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport,
+  kViolation,  ///< boundViolation's (not part of AdmmMeasures)
+  kMeasureSlots
 };
 // pcg_control's state (with the squared tolerance on ||r|| set by the host), then the
 // resumable position of admm_single_workgroup.
@@ -204,6 +215,9 @@ struct AdmmKernels::Workspace {
         dy(context, m, k, "ADMM dy"),
         centre(context, m, k, "ADMM bound centres"),
         relaxed(context, std::max<std::uint32_t>(m, 1), MemoryClass::Device, "ADMM relaxed rows"),
+        violation(context, m, k, "ADMM bound violation"),
+        sides(context, std::max<std::size_t>(sideWords(std::size_t{m} * k), 1), MemoryClass::Device,
+              "ADMM active sides"),
         pcg(context, kPcgSlots, k, n, 2 * k),
         measures(context, kMeasureSlots, k, std::max(n, m)),
         state(context, kStateSize, MemoryClass::Device, "PCG control state"),
@@ -220,6 +234,8 @@ struct AdmmKernels::Workspace {
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
   DeviceVectors centre;            ///< m x k: a relaxed start's (startRelaxed).
   Array<std::uint32_t> relaxed;    ///< m flags: a relaxed start's.
+  DeviceVectors violation;         ///< m x k: boundViolation's scratch.
+  Array<std::uint32_t> sides;      ///< The polish's active sides, packed (admm_active_sides).
   DeviceScalars pcg;
   DeviceScalars measures;
   Array<double> state;
@@ -248,11 +264,15 @@ struct AdmmKernels::Workspace {
     Sequence solve;   ///< The refinement's right-hand side and PCG from xTilde = x.
     Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
     Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
+    std::unique_ptr<Sequence> targets;  ///< z = b from the held sides (recorded on first use).
+    std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0 (recorded on first use).
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
   Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
   Eigen::MatrixXd uploadedCentre;         ///< What w.centre holds (skipped likewise).
+  std::vector<std::uint32_t> heldSides;   ///< What w.sides holds (empty: nothing known).
+  std::unique_ptr<Sequence> findSides, measureViolation;
   std::vector<char> uploadedRelaxed;      ///< What w.relaxed holds (skipped likewise).
 };
 
@@ -299,6 +319,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
                        singleWorkgroupSize(context)),
       dot_(context, "la_dot", 3, sizeof(DotPush)),
       relaxedBounds_(context, "admm_relaxed_bounds", 5, sizeof(RelaxedBoundsPush)),
+      activeSides_(context, "admm_active_sides", 5, sizeof(CountPush)),
+      polishTargets_(context, "admm_polish_targets", 4, sizeof(CountPush)),
+      boundViolation_(context, "admm_bound_violation", 4, sizeof(CountPush)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
@@ -869,15 +892,22 @@ compute::AdmmMeasures AdmmKernels::measure() {
 }
 
 void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
+  downloadSolution(x, y);
+  if (!workspace_) {  // k = 0
+    z.resize(m_, 0);
+    return;
+  }
+  workspace_->z.download(z);
+}
+
+void AdmmKernels::downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
   if (!workspace_) {  // k = 0
     x.resize(n_, 0);
     y.resize(m_, 0);
-    z.resize(m_, 0);
     return;
   }
   workspace_->x.download(x);
   workspace_->y.download(y);
-  workspace_->z.download(z);
 }
 
 void AdmmKernels::recordPolish() {
@@ -925,7 +955,10 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // device would copy empty vectors, which Vulkan forbids).
   if (!workspace_ || m_ == 0) return false;
   Workspace& w = *workspace_;
-  if (request.active.size() != m_ || request.targets.rows() != m_ || request.targets.cols() != w.k) {
+  const bool bySides = !request.sides.empty();
+  if (request.active.size() != m_ ||
+      (bySides ? request.sides.size() != std::size_t{m_} * w.k
+               : request.targets.rows() != m_ || request.targets.cols() != w.k)) {
     throwUsage("ADMM: an active set or its targets do not match the " + std::to_string(m_) + " x " +
                std::to_string(w.k) + " constraint values");
   }
@@ -955,7 +988,22 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     return true;  // not factored: the ADMM's solution stands
   }
   info.factored = true;
-  w.z.upload(request.targets);
+  if (bySides) {
+    // The sides findActiveSides found are on the device already.
+    const std::vector<std::uint32_t> packed = packSides(request.sides);
+    if (packed != w.heldSides) {
+      w.heldSides.clear();
+      w.sides.upload(packed);
+      w.heldSides = packed;
+    }
+    recordedOnce(p.targets, context_, [&](Sequence& s) {
+      const std::uint32_t count = m_ * w.k;
+      s.dispatch(polishTargets_, {w.sides, w.lower.data(), w.upper.data(), w.z.data()}, CountPush{count},
+                 groupsFor(context_, count));
+    }).run();
+  } else {
+    w.z.upload(request.targets);
+  }
   p.begin.run();
 
   // Only the relative tolerance stops these solves (no bound from ADMM residuals).
@@ -992,9 +1040,63 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     previous = residual;
   }
   info.linearIterations = static_cast<long>(state[kInnerIterations] - iterationsBefore);
-  w.x.download(x);
-  w.y.download(y);
+  if (!request.keepResult) {
+    w.x.download(x);
+    w.y.download(y);
+  }
   return true;
+}
+
+bool AdmmKernels::findActiveSides(std::vector<compute::BoundSide>& sides) {
+  if (!workspace_ || m_ == 0) return false;
+  Workspace& w = *workspace_;
+  const std::uint32_t count = m_ * w.k;
+  recordedOnce(w.findSides, context_, [&](Sequence& s) {
+    s.dispatch(activeSides_, {w.z.data(), w.y.data(), w.lower.data(), w.upper.data(), w.sides}, CountPush{count},
+               groupsFor(context_, static_cast<std::uint32_t>(sideWords(count))));
+  }).run();
+  w.heldSides.clear();
+  std::vector<std::uint32_t> words(sideWords(count));
+  w.sides.download(words);
+  sides.resize(count);
+  for (std::size_t e = 0; e < count; ++e) {
+    sides[e] = static_cast<compute::BoundSide>((words[e / 16] >> (2 * (e % 16))) & 3u);
+  }
+  w.heldSides = std::move(words);
+  return true;
+}
+
+double AdmmKernels::boundViolation() {
+  if (!workspace_ || m_ == 0) return 0.0;
+  Workspace& w = *workspace_;
+  recordedOnce(w.measureViolation, context_, [&](Sequence& s) {
+    const std::uint32_t count = m_ * w.k;
+    algebra_.spmv(s, devC_, w.x, w.Cx);
+    s.dispatch(boundViolation_, {w.Cx.data(), w.lower.data(), w.upper.data(), w.violation.data()}, CountPush{count},
+               groupsFor(context_, count));
+    s.barrier();
+    algebra_.maxAbs(s, w.violation, w.measures, kViolation);
+  }).run();
+  const std::vector<double> all = w.measures.read();
+  double violation = 0.0;
+  for (std::uint32_t c = 0; c < w.k; ++c) {
+    const double value = w.measures.at(all, kViolation, c);
+    if (std::isnan(value)) return value;
+    violation = std::max(violation, value);
+  }
+  return violation;
+}
+
+void AdmmKernels::discardRefinement() {
+  if (!workspace_ || !workspace_->polish || !workspace_->polishStartSaved) {
+    throwUsage("ADMM: no refinement to discard");
+  }
+  Workspace& w = *workspace_;
+  Workspace::Polish& p = *w.polish;
+  recordedOnce(p.discard, context_, [&](Sequence& s) {
+    algebra_.copy(s, p.x0, w.x);
+    algebra_.copy(s, p.y0, w.y);
+  }).run();
 }
 
 }  // namespace plano::vk

@@ -117,12 +117,20 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
+  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) override;
   /// On the device: K_A is assembled as K (the active flags as K1's row scales), each
   /// refinement is the ADMM's right-hand side (with z = b) and inner PCG, then one update;
   /// per refinement only the k residual norms and the PCG state come back. Throws
   /// Error(Usage) for an active set or targets of the wrong size.
   bool refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
                        compute::ActiveSetRefinementInfo& info) override;
+  /// The sides come back packed two bits each (shaders/admm_active_sides.comp) and stay on
+  /// the device: a refinement with those sides forms its targets there
+  /// (admm_polish_targets) instead of uploading them.
+  bool findActiveSides(std::vector<compute::BoundSide>& sides) override;
+  /// One check-sized read (shaders/admm_bound_violation.comp, then the inf-norms).
+  double boundViolation() override;
+  void discardRefinement() override;
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
@@ -192,7 +200,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
-  Pipeline relaxedBounds_;
+  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
