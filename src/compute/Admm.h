@@ -229,10 +229,11 @@ class AdmmKernels {
   virtual void setLinearTolerance(double tolerance) { (void)tolerance; }
   /// The current x, y and z (n x k, m x k, m x k).
   virtual void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) = 0;
-  /// x and y only (z serves the host's polish alone).
-  virtual void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
-    Eigen::MatrixXd z;
-    download(x, y, z);
+  /// x and, when y is not null, y (z serves the host's polish alone).
+  virtual void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) {
+    Eigen::MatrixXd yAll, z;
+    download(x, yAll, z);
+    if (y) *y = std::move(yAll);
   }
   /// The polish's method of multipliers on the iterate the last iterate() left (or start()
   /// loaded), where these kernels keep it, so that the polish moves no mesh-sized data per
@@ -284,7 +285,7 @@ class AdmmSolver {
   AdmmInfo iterate(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                    const RelaxedBounds* relaxed, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y);
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) { kernels_->download(x, y, z); }
-  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) { kernels_->downloadSolution(x, y); }
+  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) { kernels_->downloadSolution(x, y); }
 
   /// The same with the bounds as a relaxation (RelaxedBounds: centre m x k, one flag per
   /// row, epsilon finite and >= 0, else Error(Usage)), which the kernels form where they

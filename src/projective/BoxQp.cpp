@@ -80,12 +80,16 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
-  return solve(q, lower, upper, nullptr, x, y);
+  const BoxQpInfo info = solve(q, lower, upper, nullptr, x, y);
+  if (!settings_.returnDuals) y.resize(0, 0);
+  return info;
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
                              Eigen::MatrixXd& y) {
-  return solve(q, bounds.lower(), bounds.upper(), &bounds, x, y);
+  const BoxQpInfo info = solve(q, bounds.lower(), bounds.upper(), &bounds, x, y);
+  if (!settings_.returnDuals) y.resize(0, 0);
+  return info;
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -112,7 +116,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
   if (polishing && polishInPlace(lower, upper, info)) {
-    admm_->downloadSolution(x, y);
+    admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
   } else {
     Eigen::MatrixXd z;
     admm_->download(x, y, z);

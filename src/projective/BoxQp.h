@@ -59,6 +59,9 @@ struct BoxQpSettings : compute::AdmmSettings {
   double polishRho = 1e9;            ///< Penalty of the polish's equality system.
   /// How an all-equality problem (every row l = u) is solved (EqualitySolve).
   EqualitySolve equalitySolve = EqualitySolve::Automatic;
+  /// Return the multipliers y. A caller that never warm-starts from them turns this off:
+  /// solve() then leaves y empty, and off a device they are not copied back.
+  bool returnDuals = true;
 };
 
 enum class BoxQpStatus {
@@ -110,7 +113,8 @@ class BoxQpSolver {
   ///   q     in: n x k linear terms.
   ///   lower, upper  in: m x k bounds (lower <= upper; equal for equality rows).
   ///   x     in/out: n x k, warm start on entry (zero if empty), solution on exit.
-  ///   y     in/out: m x k dual variables, warm start on entry (zero if empty).
+  ///   y     in/out: m x k dual variables, warm start on entry (zero if empty); empty on exit
+  ///         without BoxQpSettings::returnDuals.
   /// Rows whose bounds are equal in every column are equality rows. K changes when the
   /// equality pattern or rho changed since the last solve.
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,

@@ -154,6 +154,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   // for the object's lifetime.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+  qpSettings.returnDuals = false;      // every attempt starts from zero duals
   BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
   Eigen::MatrixXd x = T;
   bool solved = false;

@@ -759,15 +759,21 @@ TEST_F(VulkanAdmm, ThePolishFindsItsActiveSidesAndKeepsItsResultOnTheDeviceAsThe
   // Up: the sides (other than the ones found), the flags and a few scalars; no targets.
   EXPECT_LE(after.uploadedBytes - before.uploadedBytes, sizeof(std::uint32_t) * 5 + sizeof(double) * 24 + 64);
   Eigen::MatrixXd x, y;
-  bySides->downloadSolution(x, y);
+  bySides->downloadSolution(x, &y);
   EXPECT_EQ(x, xTargets);
   EXPECT_EQ(y, yTargets);
 
   // Discarded, the iterate is the ADMM's again.
   bySides->discardRefinement();
-  bySides->downloadSolution(x, y);
+  bySides->downloadSolution(x, &y);
   EXPECT_EQ(x, admm.x);
   EXPECT_EQ(y, admm.y);
+  // Without y, x alone comes back.
+  before = context().transfers();
+  bySides->downloadSolution(x, nullptr);
+  after = context().transfers();
+  EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, sizeof(double) * 30 * 3);
+  EXPECT_EQ(x, admm.x);
 }
 
 TEST_F(VulkanAdmm, HostKernelsLeaveThePolishToTheCallerAndWrongActiveSetsAreUsageErrors) {

@@ -213,5 +213,25 @@ TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
   EXPECT_GT(info.iterations, 0);
 }
 
+TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 2, 10);
+  compute::RelaxedBounds bounds{qp.d, std::vector<char>(5, 1), 0.05};
+  bounds.relaxed[0] = 0;
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  BoxQpSolver withDuals(backend, qp.P, qp.C, settings);
+  settings.returnDuals = false;
+  BoxQpSolver withoutDuals(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd x, y, xAlone, yAlone = Eigen::MatrixXd::Zero(5, 2);
+  const BoxQpInfo info = withDuals.solve(qp.q, bounds, x, y);
+  const BoxQpInfo alone = withoutDuals.solve(qp.q, bounds, xAlone, yAlone);
+  EXPECT_EQ(info.status, BoxQpStatus::Solved);
+  EXPECT_TRUE(info.polished);
+  EXPECT_EQ(alone.iterations, info.iterations);
+  EXPECT_EQ(xAlone, x);
+  EXPECT_EQ(y.rows(), 5);
+  EXPECT_EQ(yAlone.size(), 0);
+}
+
 }  // namespace
 }  // namespace plano::projective

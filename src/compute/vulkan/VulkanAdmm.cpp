@@ -892,7 +892,7 @@ compute::AdmmMeasures AdmmKernels::measure() {
 }
 
 void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) {
-  downloadSolution(x, y);
+  downloadSolution(x, &y);
   if (!workspace_) {  // k = 0
     z.resize(m_, 0);
     return;
@@ -900,14 +900,14 @@ void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::Matrix
   workspace_->z.download(z);
 }
 
-void AdmmKernels::downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+void AdmmKernels::downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) {
   if (!workspace_) {  // k = 0
     x.resize(n_, 0);
-    y.resize(m_, 0);
+    if (y) y->resize(m_, 0);
     return;
   }
   workspace_->x.download(x);
-  workspace_->y.download(y);
+  if (y) workspace_->y.download(*y);
 }
 
 void AdmmKernels::recordPolish() {

@@ -117,7 +117,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
-  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd& y) override;
+  void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) override;
   /// On the device: K_A is assembled as K (the active flags as K1's row scales), each
   /// refinement is the ADMM's right-hand side (with z = b) and inner PCG, then one update;
   /// per refinement only the k residual norms and the PCG state come back. Throws
