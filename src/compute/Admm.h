@@ -175,7 +175,9 @@ struct ActiveSetRefinement {
   std::vector<BoundSide> sides;
   /// Leave the result where the kernels keep the iterate (x and y are not written): the
   /// caller measures it (boundViolation), keeps it or discards it (discardRefinement), and
-  /// fetches what it keeps with download().
+  /// fetches what it keeps with download(). Such refinements accumulate: after each, the
+  /// iterate holds every column refined since the ADMM's iterate as its last refinement
+  /// left it, and the ADMM's other columns (one refinement per active set, merged).
   bool keepResult = false;
 };
 
@@ -263,8 +265,8 @@ class AdmmKernels {
   /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN when C x is
   /// not finite.
   virtual double boundViolation();
-  /// Make the iterate the one the last refineActiveSet started from (the ADMM's), after a
-  /// refinement with keepResult that the caller rejects.
+  /// Make the iterate the one the refinements started from (the ADMM's), after
+  /// refinements with keepResult that the caller rejects.
   virtual void discardRefinement();
 };
 

@@ -132,31 +132,49 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
   if (!admm_->findActiveSides(sides)) return false;
   const Eigen::Index m = C_.rows();
   const Eigen::Index k = lower.cols();
-  std::vector<char> active(m);
-  for (Eigen::Index i = 0; i < m; ++i) active[i] = sides[i] != compute::BoundSide::Free;
-  double largestTarget = 0.0;
-  for (Eigen::Index c = 0; c < k; ++c) {
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const compute::BoundSide side = sides[c * m + i];
-      // Columns with other active sets need a refinement each, merged on the host (polish).
-      if ((side != compute::BoundSide::Free) != static_cast<bool>(active[i])) return false;
-      if (side == compute::BoundSide::Lower) largestTarget = std::max(largestTarget, std::abs(lower(i, c)));
-      if (side == compute::BoundSide::Upper) largestTarget = std::max(largestTarget, std::abs(upper(i, c)));
+  // Column c's active set: its rows not free.
+  const auto activeOf = [&](Eigen::Index c) {
+    std::vector<char> active(m);
+    for (Eigen::Index i = 0; i < m; ++i) active[i] = sides[c * m + i] != compute::BoundSide::Free;
+    return active;
+  };
+  const double before = admm_->boundViolation();
+  std::vector<char> done(k, 0);
+  for (Eigen::Index first = 0; first < k; ++first) {
+    if (done[first]) continue;
+    // Columns with the same active set share one refinement; the kernels merge the sets'.
+    const std::vector<char> active = activeOf(first);
+    std::vector<Eigen::Index> columns;
+    double largestTarget = 0.0;
+    for (Eigen::Index c = first; c < k; ++c) {
+      if (done[c] || activeOf(c) != active) continue;
+      columns.push_back(c);
+      done[c] = 1;
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const compute::BoundSide side = sides[c * m + i];
+        if (side == compute::BoundSide::Lower) largestTarget = std::max(largestTarget, std::abs(lower(i, c)));
+        if (side == compute::BoundSide::Upper) largestTarget = std::max(largestTarget, std::abs(upper(i, c)));
+      }
+    }
+    const compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho,
+                                               settings_.polishIterations,
+                                               kRoundingGoal * std::max(1.0, largestTarget), sides, true};
+    compute::ActiveSetRefinementInfo refined;
+    Eigen::MatrixXd unusedX, unusedY;
+    if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) {
+      if (first == 0) return false;  // declined at once: the iterate is untouched
+      throwUsage("box QP: the ADMM's kernels declined a polish they had begun");
+    }
+    info.polishRefinements += refined.refinements;
+    // The stiff polish system can be too ill-conditioned to form; polishing is an optional
+    // refinement, so the ADMM's solution stands.
+    if (!refined.factored) {
+      admm_->discardRefinement();
+      return true;
     }
   }
-  std::vector<Eigen::Index> columns(k);
-  for (Eigen::Index c = 0; c < k; ++c) columns[c] = c;
-  compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho,
-                                       settings_.polishIterations, kRoundingGoal * std::max(1.0, largestTarget),
-                                       std::move(sides), true};
-  const double before = admm_->boundViolation();
-  compute::ActiveSetRefinementInfo refined;
-  Eigen::MatrixXd unusedX, unusedY;
-  if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) return false;
-  info.polishRefinements += refined.refinements;
-  // Not factored: the ADMM's solution stands (the iterate is untouched). A refinement that
-  // leaves the bounds more violated (or non-finite: NaN fails the test) is discarded.
-  if (!refined.factored) return true;
+  // A polish that leaves the bounds more violated (or non-finite: NaN fails the test) is
+  // discarded.
   const double after = admm_->boundViolation();
   if (!(after <= std::max(before, 1e-12))) {
     admm_->discardRefinement();

@@ -147,12 +147,12 @@ class BoxQpSolver {
   /// Both solves': `relaxed` (when not null) is the bounds' form to hand the ADMM.
   BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   const compute::RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
-  /// The polish where the ADMM's kernels keep the iterate (compute::AdmmKernels::
-  /// findActiveSides), when they find its active sets there and every column shares one (a
-  /// deformation's all-equality steps; columns with sets of their own take a refinement
-  /// each, which polish() merges on the host): only the sides found (a byte per four rows
-  /// and columns) and a few norms cross, and the iterate stays for the final download.
-  /// Sets info.polished and polishRefinements; false when it cannot (iterate untouched).
+  /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
+  /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
+  /// by the kernels; only the sides found (a byte per four rows and columns), the active
+  /// flags of each set and a few norms cross, and the iterate stays for the final download.
+  /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
+  /// untouched: polish() then works from the downloaded iterate).
   bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);

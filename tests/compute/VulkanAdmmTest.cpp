@@ -776,6 +776,49 @@ TEST_F(VulkanAdmm, ThePolishFindsItsActiveSidesAndKeepsItsResultOnTheDeviceAsThe
   EXPECT_EQ(x, admm.x);
 }
 
+TEST_F(VulkanAdmm, ABoxQpPolishesEachColumnsActiveSetOnTheDeviceGivingTheCpusPolishedSolution) {
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  // The columns' active sets differ: one refinement each, merged on the device.
+  const AdmmRun admm = runAdmm(*deviceSolver(context(), qp, compute::AdmmSettings(), kRecordings[1]), qp);
+  const std::vector<compute::BoundSide> sides = hostSides(qp, admm.z, admm.y);
+  const auto activeOf = [&](Index c) {
+    std::vector<bool> active;
+    for (Index i = 0; i < 24; ++i) active.push_back(sides[c * 24 + i] != compute::BoundSide::Free);
+    return active;
+  };
+  ASSERT_TRUE(activeOf(0) != activeOf(1) || activeOf(0) != activeOf(2));
+
+  projective::BoxQpSettings settings;
+  settings.linearSolver.relativeTolerance = 1e-12;
+  settings.polishRho = 1e6;  // as above: the solution is the same, the PCG's iterations far fewer
+  compute::CpuBackend cpu;
+  projective::BoxQpSolver host(cpu, qp.P, qp.C, settings);
+  projective::BoxQpSolver device(backend(), qp.P, qp.C, settings);
+  Eigen::MatrixXd xHost, yHost, x, y;
+  const projective::BoxQpInfo hostInfo = host.solve(qp.q, qp.lower, qp.upper, xHost, yHost);
+  const vk::TransferCounts before = context().transfers();
+  const projective::BoxQpInfo info = device.solve(qp.q, qp.lower, qp.upper, x, y);
+  const vk::TransferCounts after = context().transfers();
+  EXPECT_TRUE(hostInfo.polished);
+  EXPECT_TRUE(info.polished);
+  EXPECT_LT(relativeDifference(x, xHost), 1e-8);
+  EXPECT_LT(relativeDifference(y, yHost), 1e-6);
+  EXPECT_LE(info.maxBoundViolation, 1e-9);
+  // Down, past what the ADMM's checks read (a twin ADMM without the polish): the sides, two
+  // violations, each refinement's norms and PCG state, x and y once; never z, nor the ADMM's
+  // x and y (the host's polish: 1 872 bytes, then x and y per active set).
+  auto twin = backend().createAdmmSolver(qp.P, qp.C, settings);
+  const vk::TransferCounts twinBefore = context().transfers();
+  const compute::AdmmInfo twinInfo = twin->iterate(qp.q, qp.lower, qp.upper, nullptr, Eigen::MatrixXd(),
+                                                   Eigen::MatrixXd());
+  const vk::TransferCounts twinAfter = context().transfers();
+  ASSERT_EQ(twinInfo.iterations, info.iterations);
+  const std::size_t checks = twinAfter.downloadedBytes - twinBefore.downloadedBytes;
+  const std::size_t solution = sizeof(double) * (30 + 24) * 3;
+  const auto refinementReads = static_cast<std::size_t>(info.polishRefinements) * 512 + 1024;
+  EXPECT_LE(after.downloadedBytes - before.downloadedBytes, checks + solution + refinementReads);
+}
+
 TEST_F(VulkanAdmm, HostKernelsLeaveThePolishToTheCallerAndWrongActiveSetsAreUsageErrors) {
   const BoxQp qp = randomBoxQp(24, 18, 5);
   compute::CpuBackend cpu;

@@ -256,10 +256,12 @@ struct AdmmKernels::Workspace {
   /// after start() or iterate()), and its recordings.
   struct Polish {
     Polish(Context& context, std::uint32_t n, std::uint32_t m, std::uint32_t k)
-        : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"), save(context),
+        : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"),
+          xKept(context, n, k, "polish result x"), yKept(context, m, k, "polish result y"), save(context),
           begin(context), solve(context), resume(context), update(context) {}
     DeviceVectors x0, y0;
-    Sequence save;    ///< x0 = x, y0 = y
+    DeviceVectors xKept, yKept;  ///< keepResult's: the columns refined since the save, the others x0, y0.
+    Sequence save;    ///< x0 = x, y0 = y, and the kept result the same
     Sequence begin;   ///< x = x0, lambda = y = diag(active) y0
     Sequence solve;   ///< The refinement's right-hand side and PCG from xTilde = x.
     Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
@@ -918,6 +920,8 @@ void AdmmKernels::recordPolish() {
   p.save.begin();
   la.copy(p.save, w.x, p.x0);
   la.copy(p.save, w.y, p.y0);
+  la.copy(p.save, w.x, p.xKept);
+  la.copy(p.save, w.y, p.yKept);
   p.save.end();
   // rowScales_ holds the active flags (assembleK1), rhoRows_ = rho times them (assembleK).
   p.begin.begin();
@@ -1043,7 +1047,23 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   if (!request.keepResult) {
     w.x.download(x);
     w.y.download(y);
+    return true;
   }
+  // The refined columns join the kept result, which becomes the iterate (columns are
+  // contiguous: one copy each).
+  Sequence keep(context_);
+  keep.begin();
+  const std::size_t xBytes = std::size_t{n_} * sizeof(double), yBytes = std::size_t{m_} * sizeof(double);
+  for (const Eigen::Index c : request.columns) {
+    const auto column = static_cast<std::size_t>(c);
+    keep.copy(w.x.data(), p.xKept.data(), xBytes, column * xBytes, column * xBytes);
+    keep.copy(w.y.data(), p.yKept.data(), yBytes, column * yBytes, column * yBytes);
+  }
+  keep.barrier();
+  algebra_.copy(keep, p.xKept, w.x);
+  algebra_.copy(keep, p.yKept, w.y);
+  keep.end();
+  keep.run();
   return true;
 }
 
@@ -1096,6 +1116,8 @@ void AdmmKernels::discardRefinement() {
   recordedOnce(p.discard, context_, [&](Sequence& s) {
     algebra_.copy(s, p.x0, w.x);
     algebra_.copy(s, p.y0, w.y);
+    algebra_.copy(s, p.x0, p.xKept);
+    algebra_.copy(s, p.y0, p.yKept);
   }).run();
 }
 
