@@ -257,7 +257,7 @@ class AdmmKernels {
   /// rule (projective/BoxQp.cpp's): per row and column (m x k, column-major) Lower where
   /// l = u or z - l < -y, else Upper where u - z < y, else Free. Returns false when these
   /// kernels have no such step or no refineActiveSet with sides and keepResult (the caller
-  /// then polishes from download()), and then also the three below are not available.
+  /// then polishes from download()), and then also the two below are not available.
   virtual bool findActiveSides(std::vector<BoundSide>& sides) {
     (void)sides;
     return false;
