@@ -52,9 +52,7 @@ struct SingleWorkgroupPush {
 enum PcgSlot : std::uint32_t { kRzEven = 0, kRrEven, kRzOdd, kRrOdd, kPq, kBz, kPcgSlots };
 // Check scalar slots (k values each), in AdmmMeasures' order.
 enum MeasureSlot : std::uint32_t {
-  kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport,
-  kViolation,  ///< boundViolation's (not part of AdmmMeasures)
-  kMeasureSlots
+  kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
 };
 // pcg_control's state (with the squared tolerance on ||r|| set by the host), then the
 // resumable position of admm_single_workgroup.
@@ -180,6 +178,15 @@ Sequence& recordedOnce(std::unique_ptr<Sequence>& slot, Context& context, Record
   return *slot;
 }
 
+/// Upload `values` to `device` unless `held` (what it holds) equals them: the attempts of
+/// an ε schedule share q and the bounds' centre.
+void uploadIfChanged(DeviceVectors& device, Eigen::MatrixXd& held, const Eigen::MatrixXd& values) {
+  if (held.rows() == values.rows() && held.cols() == values.cols() && held == values) return;
+  held.resize(0, 0);  // an upload that throws leaves nothing claimed
+  device.upload(values);
+  held = values;
+}
+
 /// A device array holding `values` (at least one element: Vulkan buffers are never empty).
 Array<std::int32_t> uploaded(Context& context, const std::vector<std::int32_t>& values, const char* what) {
   Array<std::int32_t> array(context, std::max<std::size_t>(values.size(), 1), MemoryClass::Device, what);
@@ -220,6 +227,7 @@ struct AdmmKernels::Workspace {
               "ADMM active sides"),
         pcg(context, kPcgSlots, k, n, 2 * k),
         measures(context, kMeasureSlots, k, std::max(n, m)),
+        violationNorms(context, 1, k, std::max(m, 1u)),
         state(context, kStateSize, MemoryClass::Device, "PCG control state"),
         arguments(context, 12, MemoryClass::Device, "PCG indirect arguments"),
         check(context) {}
@@ -238,6 +246,7 @@ struct AdmmKernels::Workspace {
   Array<std::uint32_t> sides;      ///< The polish's active sides, packed (admm_active_sides).
   DeviceScalars pcg;
   DeviceScalars measures;
+  DeviceScalars violationNorms;  ///< boundViolation's, apart from the checks' reads.
   Array<double> state;
   Array<std::uint32_t> arguments;
   // The inner PCG's descriptor sets, built once: a block records thousands of dispatches.
@@ -773,11 +782,7 @@ bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
   Workspace& w = *workspace_;
   // The attempts of one global step's ε schedule solve with one q (only the bounds widen):
   // the device keeps it (nothing else writes w.q).
-  if (!(w.uploadedQ.rows() == q.rows() && w.uploadedQ.cols() == q.cols() && w.uploadedQ == q)) {
-    w.uploadedQ.resize(0, 0);  // an upload that throws leaves nothing claimed
-    w.q.upload(q);
-    w.uploadedQ = q;
-  }
+  uploadIfChanged(w.q, w.uploadedQ, q);
   return true;
 }
 
@@ -797,12 +802,7 @@ void AdmmKernels::startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedB
     throwUsage("Vulkan ADMM: relaxed bounds need an m x k centre and one flag per row");
   }
   // An ε schedule's attempts share the centre and the flags, a loop's steps the flags.
-  if (!(w.uploadedCentre.rows() == bounds.centre.rows() && w.uploadedCentre.cols() == bounds.centre.cols() &&
-        w.uploadedCentre == bounds.centre)) {
-    w.uploadedCentre.resize(0, 0);
-    w.centre.upload(bounds.centre);
-    w.uploadedCentre = bounds.centre;
-  }
+  uploadIfChanged(w.centre, w.uploadedCentre, bounds.centre);
   if (m_ > 0 && w.uploadedRelaxed != bounds.relaxed) {
     w.uploadedRelaxed.clear();
     const std::vector<std::uint32_t> flags(bounds.relaxed.begin(), bounds.relaxed.end());
@@ -1095,12 +1095,12 @@ double AdmmKernels::boundViolation() {
     s.dispatch(boundViolation_, {w.Cx.data(), w.lower.data(), w.upper.data(), w.violation.data()}, CountPush{count},
                groupsFor(context_, count));
     s.barrier();
-    algebra_.maxAbs(s, w.violation, w.measures, kViolation);
+    algebra_.maxAbs(s, w.violation, w.violationNorms, 0);
   }).run();
-  const std::vector<double> all = w.measures.read();
+  const std::vector<double> all = w.violationNorms.read();
   double violation = 0.0;
   for (std::uint32_t c = 0; c < w.k; ++c) {
-    const double value = w.measures.at(all, kViolation, c);
+    const double value = w.violationNorms.at(all, 0, c);
     if (std::isnan(value)) return value;
     violation = std::max(violation, value);
   }
