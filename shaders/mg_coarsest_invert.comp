@@ -14,8 +14,9 @@ layout(local_size_x_id = 0) in;
 // vk::Multigrid::kMaxCoarsestRows.
 #define MG_COARSEST_MAX_ROWS 1024
 
-layout(std430, binding = 0) buffer Dense { double a[]; };
-layout(std430, binding = 1) buffer Failure { uint failure[]; };
+// coherent: every step reads what other lanes of the workgroup wrote in the step before.
+layout(std430, binding = 0) coherent buffer Dense { double a[]; };
+layout(std430, binding = 1) coherent buffer Failure { uint failure[]; };
 
 layout(push_constant) uniform Push {
   uint rows;

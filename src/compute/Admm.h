@@ -177,7 +177,8 @@ struct ActiveSetRefinement {
   /// caller measures it (boundViolation), keeps it or discards it (discardRefinement), and
   /// fetches what it keeps with download(). Such refinements accumulate: after each, the
   /// iterate holds every column refined since the ADMM's iterate as its last refinement
-  /// left it, and the ADMM's other columns (one refinement per active set, merged).
+  /// left it, and the ADMM's other columns (one refinement per active set, merged); z stays
+  /// the ADMM's.
   bool keepResult = false;
 };
 
@@ -262,8 +263,8 @@ class AdmmKernels {
     (void)sides;
     return false;
   }
-  /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN when C x is
-  /// not finite.
+  /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN (or +Inf)
+  /// when C x is not finite.
   virtual double boundViolation();
   /// Make the iterate the one the refinements started from (the ADMM's), after
   /// refinements with keepResult that the caller rejects.

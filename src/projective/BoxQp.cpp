@@ -117,10 +117,12 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
   if (polishing && polishInPlace(lower, upper, info)) {
     admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
-  } else {
-    Eigen::MatrixXd z;
+  } else if (polishing) {
+    Eigen::MatrixXd z;  // the host's polish needs the whole iterate
     admm_->download(x, y, z);
-    if (polishing) info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
+    info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
+  } else {
+    admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
   }
   info.maxBoundViolation = boundViolation(C_ * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;

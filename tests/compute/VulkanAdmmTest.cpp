@@ -762,12 +762,17 @@ TEST_F(VulkanAdmm, ThePolishFindsItsActiveSidesAndKeepsItsResultOnTheDeviceAsThe
   bySides->downloadSolution(x, &y);
   EXPECT_EQ(x, xTargets);
   EXPECT_EQ(y, yTargets);
+  // z is the ADMM's still, not the refinement's targets.
+  Eigen::MatrixXd xAll, yAll, z;
+  bySides->download(xAll, yAll, z);
+  EXPECT_EQ(z, admm.z);
 
   // Discarded, the iterate is the ADMM's again.
   bySides->discardRefinement();
-  bySides->downloadSolution(x, &y);
+  bySides->download(x, y, z);
   EXPECT_EQ(x, admm.x);
   EXPECT_EQ(y, admm.y);
+  EXPECT_EQ(z, admm.z);
   // Without y, x alone comes back.
   before = context().transfers();
   bySides->downloadSolution(x, nullptr);

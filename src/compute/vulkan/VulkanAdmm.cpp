@@ -266,17 +266,18 @@ struct AdmmKernels::Workspace {
   struct Polish {
     Polish(Context& context, std::uint32_t n, std::uint32_t m, std::uint32_t k)
         : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"),
-          xKept(context, n, k, "polish result x"), yKept(context, m, k, "polish result y"), save(context),
+          z0(context, m, k, "polish start z"), xKept(context, n, k, "polish result x"), yKept(context, m, k, "polish result y"), save(context),
           begin(context), solve(context), resume(context), update(context) {}
     DeviceVectors x0, y0;
+    DeviceVectors z0;  ///< The ADMM's z: each refinement sets z to its targets, the end restores it.
     DeviceVectors xKept, yKept;  ///< keepResult's: the columns refined since the save, the others x0, y0.
-    Sequence save;    ///< x0 = x, y0 = y, and the kept result the same
+    Sequence save;    ///< x0 = x, y0 = y, z0 = z, and the kept result x0, y0
     Sequence begin;   ///< x = x0, lambda = y = diag(active) y0
     Sequence solve;   ///< The refinement's right-hand side and PCG from xTilde = x.
     Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
     Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
     std::unique_ptr<Sequence> targets;  ///< z = b from the held sides (recorded on first use).
-    std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0 (recorded on first use).
+    std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0, z = z0 (recorded on first use).
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
@@ -920,6 +921,7 @@ void AdmmKernels::recordPolish() {
   p.save.begin();
   la.copy(p.save, w.x, p.x0);
   la.copy(p.save, w.y, p.y0);
+  la.copy(p.save, w.z, p.z0);
   la.copy(p.save, w.x, p.xKept);
   la.copy(p.save, w.y, p.yKept);
   p.save.end();
@@ -1062,6 +1064,7 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   keep.barrier();
   algebra_.copy(keep, p.xKept, w.x);
   algebra_.copy(keep, p.yKept, w.y);
+  algebra_.copy(keep, p.z0, w.z);  // the ADMM's z again, not this refinement's targets
   keep.end();
   keep.run();
   return true;
@@ -1071,11 +1074,11 @@ bool AdmmKernels::findActiveSides(std::vector<compute::BoundSide>& sides) {
   if (!workspace_ || m_ == 0) return false;
   Workspace& w = *workspace_;
   const std::uint32_t count = m_ * w.k;
+  w.heldSides.clear();  // before the run: should it fail, w.sides holds nothing known
   recordedOnce(w.findSides, context_, [&](Sequence& s) {
     s.dispatch(activeSides_, {w.z.data(), w.y.data(), w.lower.data(), w.upper.data(), w.sides}, CountPush{count},
                groupsFor(context_, static_cast<std::uint32_t>(sideWords(count))));
   }).run();
-  w.heldSides.clear();
   std::vector<std::uint32_t> words(sideWords(count));
   w.sides.download(words);
   sides.resize(count);
@@ -1116,6 +1119,7 @@ void AdmmKernels::discardRefinement() {
   recordedOnce(p.discard, context_, [&](Sequence& s) {
     algebra_.copy(s, p.x0, w.x);
     algebra_.copy(s, p.y0, w.y);
+    algebra_.copy(s, p.z0, w.z);
     algebra_.copy(s, p.x0, p.xKept);
     algebra_.copy(s, p.y0, p.yKept);
   }).run();
