@@ -38,6 +38,22 @@ struct ProjectiveFits {
   std::vector<int> ranks;                 ///< Per face: numerical rank of the fit's system.
 };
 
+/// How a face's closest ideal map was found (Backend::closestIdealMaps).
+enum class IdealMapMethod : std::int32_t {
+  Jacobian = 0,          ///< From the fit's Jacobian at the face centroid, restricted to the face plane.
+  /// The fit sends the centroid or a corner through the plane at infinity (its Jacobian
+  /// says nothing about the face): Kabsch / Umeyama between source and target corners.
+  CornerProcrustes = 1,
+  /// As CornerProcrustes, but no target corners were given: no ideal map (the identity).
+  CentroidAtInfinity = 2,
+};
+
+/// Result of the batched closest ideal maps, one entry per face.
+struct IdealMaps {
+  std::vector<Eigen::Matrix4d> maps;     ///< #F affine maps [[s R, 0], [t, 1]], T(3, 3) = 1.
+  std::vector<IdealMapMethod> methods;   ///< #F.
+};
+
 /// Settings of an iterative or direct SPD solve.
 struct LinearSolverSettings {
   double relativeTolerance = 1e-10;  ///< Iterative solvers stop at ||r|| <= tol * ||b||.
@@ -112,6 +128,16 @@ class Backend {
   /// the signed singular values (s1, s2, d * s3), so that R^T M = V diag(...) V^T.
   virtual void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                                 std::span<Eigen::Vector3d> singularValues) = 0;
+
+  /// Batched closest ideal maps (projective-maps paper, App. A; the math of
+  /// projective/IdealMapFit.h): for every face, the rigid (or, with `similar`, similarity)
+  /// map closest to its fitted projective map `fitted[f]` from `source` corners (#V x 3,
+  /// normalized coordinates), through the closest rotation of the fit's in-plane Jacobian at
+  /// the face centroid; a fit that sends part of the face through the plane at infinity
+  /// falls back to the corner-set Procrustes to `target` (#V x 3, the positions fitted to;
+  /// may be null). `fitted` has #F entries (Error(Usage) otherwise).
+  virtual void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                                const Positions* target, bool similar, IdealMaps& out) = 0;
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;

@@ -22,13 +22,14 @@ enum class IdealMapKind {
 /// (the fit leaves the out-of-plane action arbitrary, "closest to the identity", which must
 /// not leak into the rotation). The 3x3 linear map L sends the source plane basis e1, e2
 /// to e1 J, e2 J and the source normal to the unit normal of their span, so L maps plane
-/// to plane and normal to normal and its closest rotation R (Backend::closestRotations) is
+/// to plane and normal to normal and its closest rotation R is
 /// the in-plane rotation of the fit. The similarity scale is the mean of the two
 /// singular values of the in-plane 2x2 map, s = (s1 + s2) / 2 = sqrt(|M|^2 + 2|det M|) / 2.
 /// The translation keeps the first-order expansion of the fit about the centroid:
 /// x -> phi(c) + (x - c) s R, with phi the dehomogenized fitted map.
 ///
-///   backend  in: runs the batched Procrustes.
+///   backend  in: runs the batched maps (Backend::closestIdealMaps; the per-face math is
+///            projective/IdealMapFit.h's, a kernel of its own on Vulkan).
 ///   space    in: base mesh (normalized coordinates).
 ///   fitted   in: #F fitted maps T_f (normalized coordinates, row-vector convention).
 ///   kind     in: rigid or similar.

@@ -18,6 +18,10 @@ class CpuForwardingBackend : public compute::Backend {
                         std::span<Eigen::Vector3d> singularValues) override {
     cpu_.closestRotations(matrices, rotations, singularValues);
   }
+  void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                        const Positions* target, bool similar, compute::IdealMaps& out) override {
+    cpu_.closestIdealMaps(faces, source, fitted, target, similar, out);
+  }
   std::unique_ptr<compute::SpdSolver> createSpdSolver(const compute::SparseMatrix& A,
                                                       const compute::LinearSolverSettings& settings) override {
     return cpu_.createSpdSolver(A, settings);

@@ -8,6 +8,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "mesh/Planarity.h"
+#include "projective/IdealMapFit.h"
 #include "projective/LocalFit.h"
 
 namespace plano::compute {
@@ -114,6 +115,36 @@ void CpuBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std
     rotations[i] = U * Eigen::Vector3d(1.0, 1.0, d).asDiagonal() * V.transpose();
     singularValues[i] = svd.singularValues();
     singularValues[i][2] *= d;
+  }
+}
+
+void CpuBackend::closestIdealMaps(const FaceList& faces, const Positions& source,
+                                  std::span<const Eigen::Matrix4d> fitted, const Positions* target, bool similar,
+                                  IdealMaps& out) {
+  const Index faceCount = faces.size();
+  if (static_cast<Index>(fitted.size()) != faceCount) {
+    throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faceCount) +
+               " faces");
+  }
+  out.maps.resize(faceCount);
+  out.methods.resize(faceCount);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> p, q;
+  for (Index f = 0; f < faceCount; ++f) {
+    const auto face = faces[f];
+    const auto k = static_cast<Eigen::Index>(face.size());
+    p.resize(k, 3);
+    q.resize(k, 3);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      p.row(i) = source.row(face[i]);
+      if (target) q.row(i) = target->row(face[i]);
+    }
+    const projective::IdealMapLinearization lin = projective::linearizeFaceMap(p, fitted[f], target ? &q : nullptr);
+    Eigen::Matrix3d R;
+    Eigen::Vector3d singular;
+    closestRotations({&lin.linear, 1}, {&R, 1}, {&singular, 1});
+    out.methods[f] = lin.method;
+    out.maps[f] = lin.method == IdealMapMethod::CentroidAtInfinity ? Eigen::Matrix4d::Identity()
+                                                                    : projective::idealMapOf(lin, R, singular, similar);
   }
 }
 

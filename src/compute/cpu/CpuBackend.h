@@ -15,6 +15,8 @@ class CpuBackend final : public Backend {
                          ProjectiveFits& out) override;
   void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                         std::span<Eigen::Vector3d> singularValues) override;
+  void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                        const Positions* target, bool similar, IdealMaps& out) override;
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
   bool factorsSpdMatrices() const override { return true; }  ///< CHOLMOD
 };

@@ -3,6 +3,7 @@
 #include "compute/vulkan/VulkanAdmm.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "compute/vulkan/VulkanClosestRotations.h"
+#include "compute/vulkan/VulkanIdealMaps.h"
 #include "compute/vulkan/VulkanFacePlanarity.h"
 #include "compute/vulkan/VulkanPcgSolver.h"
 #include "compute/vulkan/VulkanProjectiveFit.h"
@@ -40,6 +41,18 @@ void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, 
                                      std::span<Eigen::Vector3d> singularValues) {
   if (!rotations_) rotations_ = std::make_unique<vk::ClosestRotationsKernel>(*context_);
   rotations_->run(matrices, rotations, singularValues);
+}
+
+void VulkanBackend::closestIdealMaps(const FaceList& faces, const Positions& source,
+                                     std::span<const Eigen::Matrix4d> fitted, const Positions* target, bool similar,
+                                     IdealMaps& out) {
+  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_);
+  // The fits of a deformation's local step come from this backend's fit kernel, whose
+  // device arrays still hold them and the positions they were fitted to.
+  const vk::Array<double>* residentFitted = projectiveFit_ ? projectiveFit_->mapsHolding(fitted) : nullptr;
+  const vk::Array<double>* residentTarget =
+      projectiveFit_ && target ? projectiveFit_->targetHolding(*target) : nullptr;
+  idealMaps_->run(faces, source, fitted, target, similar, out, residentFitted, residentTarget);
 }
 
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {

@@ -10,6 +10,7 @@ class Context;
 class FacePlanarityKernel;
 class ProjectiveFitKernel;
 class ClosestRotationsKernel;
+class IdealMapsKernel;
 }  // namespace plano::vk
 
 namespace plano::compute {
@@ -33,6 +34,8 @@ class VulkanBackend final : public Backend {
                          ProjectiveFits& out) override;
   void closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                         std::span<Eigen::Vector3d> singularValues) override;
+  void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                        const Positions* target, bool similar, IdealMaps& out) override;
   /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
@@ -57,6 +60,7 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<vk::FacePlanarityKernel> planarity_;
   std::unique_ptr<vk::ProjectiveFitKernel> projectiveFit_;
   std::unique_ptr<vk::ClosestRotationsKernel> rotations_;
+  std::unique_ptr<vk::IdealMapsKernel> idealMaps_;
 };
 
 /// Create the Vulkan backend. The device can be forced with the environment variable

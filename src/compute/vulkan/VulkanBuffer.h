@@ -95,15 +95,19 @@ class CachedArray {
  public:
   /// Make the device array hold `values` (grown as ensureCapacity grows).
   void assign(Context& context, std::span<const T> values, const char* what) {
-    const bool same = array_.handle() != VK_NULL_HANDLE && last_.size() == values.size() &&
-                      std::equal(values.begin(), values.end(), last_.begin());
-    if (same) return;
+    if (holds(values)) return;
     last_.clear();  // an upload that throws leaves nothing claimed
     ensureCapacity(array_, context, values.size(), what);
     array_.upload(values);
     last_.assign(values.begin(), values.end());
   }
   Array<T>& array() { return array_; }
+  const Array<T>& array() const { return array_; }
+  /// Whether the device array holds exactly `values`.
+  bool holds(std::span<const T> values) const {
+    return array_.handle() != VK_NULL_HANDLE && last_.size() == values.size() &&
+           std::equal(values.begin(), values.end(), last_.begin());
+  }
 
  private:
   Array<T> array_;

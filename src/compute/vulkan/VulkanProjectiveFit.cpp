@@ -50,8 +50,8 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                 std::to_string(range) + " bytes; use the CPU backend");
   }
   source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
-  ensureCapacity(target_, context_, target.size(), "target positions");
-  target_.upload({target.data(), static_cast<std::size_t>(target.size())});
+  target_.assign(context_, {target.data(), static_cast<std::size_t>(target.size())}, "target positions");
+  lastMaps_.clear();
   offsets_.assign(context_, faces.offsets(), "face offsets");
   indices_.assign(context_, faces.indices(), "face corners");
 
@@ -71,14 +71,15 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
   ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
   ensureCapacity(ranks_, context_, maxFaces, "fit ranks");
   DescriptorSet set(context_, pipeline_,
-                    {BufferRange(source_.array(), 0, positionBytes), BufferRange(target_, 0, positionBytes),
+                    {BufferRange(source_.array(), 0, positionBytes), BufferRange(target_.array(), 0, positionBytes),
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
                      BufferRange(maps_, 0, maxFaces * kMapBytes),
                      BufferRange(scales_, 0, maxCorners * sizeof(double)),
                      BufferRange(residuals_, 0, maxFaces * sizeof(double)),
                      BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});
   Sequence sequence(context_);
-  for (std::size_t first = 0; first < faceCount;) {
+  std::size_t chunks = 0;
+  for (std::size_t first = 0; first < faceCount; ++chunks) {
     std::size_t last = std::min(faceCount, first + maxFaces);
     while (static_cast<std::size_t>(offset[last] - offset[first]) * sizeof(double) > range) --last;
     const std::size_t n = last - first;
@@ -94,6 +95,17 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
     ranks_.download(std::span<std::int32_t>(out.ranks.data() + first, n));
     first = last;
   }
+  if (chunks == 1) lastMaps_ = out.maps;  // maps_ holds them all
+}
+
+const Array<double>* ProjectiveFitKernel::mapsHolding(std::span<const Eigen::Matrix4d> maps) const {
+  const bool same = !lastMaps_.empty() && lastMaps_.size() == maps.size() &&
+                    std::equal(maps.begin(), maps.end(), lastMaps_.begin());
+  return same ? &maps_ : nullptr;
+}
+
+const Array<double>* ProjectiveFitKernel::targetHolding(const Positions& target) const {
+  return target_.holds({target.data(), static_cast<std::size_t>(target.size())}) ? &target_.array() : nullptr;
 }
 
 }  // namespace plano::vk

@@ -23,13 +23,21 @@ class ProjectiveFitKernel {
   /// positions exceed the device's storage-buffer range.
   void run(const FaceList& faces, const Positions& source, const Positions& target, compute::ProjectiveFits& out);
 
+  /// The device array of the last run's maps (16 doubles a face, column-major) when it
+  /// holds exactly `maps` (a run of one chunk), else null; and that of its targets when
+  /// they were exactly `target`. A kernel of the same context that takes the fits next
+  /// (vk::IdealMapsKernel) binds these instead of uploading its inputs again.
+  const Array<double>* mapsHolding(std::span<const Eigen::Matrix4d> maps) const;
+  const Array<double>* targetHolding(const Positions& target) const;
+
  private:
   Context& context_;
   ProjectiveFitSettings settings_;
   Pipeline pipeline_;
   // Reused across calls (grow-only): a local/global loop allocates once.
   CachedArray<double> source_;  ///< A loop fits to one source (the base mesh) every iteration.
-  Array<double> target_;
+  CachedArray<double> target_;
+  std::vector<Eigen::Matrix4d> lastMaps_;  ///< What maps_ holds after a run of one chunk (else empty).
   CachedArray<Index> offsets_, indices_;
   Array<double> maps_, scales_, residuals_;
   Array<std::int32_t> ranks_;

@@ -1,0 +1,94 @@
+#include "compute/vulkan/VulkanIdealMaps.h"
+
+#include <algorithm>
+#include <string>
+
+#include "compute/vulkan/VulkanInputChecks.h"
+#include "core/Error.h"
+
+namespace plano::vk {
+namespace {
+
+struct Push {
+  std::uint32_t firstFace;
+  std::uint32_t faceCount;
+  std::uint32_t hasTarget;
+  std::uint32_t similar;
+};
+
+static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 16 packed doubles");
+static_assert(sizeof(compute::IdealMapMethod) == sizeof(std::int32_t), "methods are 32-bit on the device");
+
+constexpr std::size_t kMapBytes = 16 * sizeof(double);
+
+}  // namespace
+
+IdealMapsKernel::IdealMapsKernel(Context& context)
+    : context_(context), pipeline_(context, "ideal_maps", 7, sizeof(Push)) {}
+
+void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                          const Positions* target, bool similar, compute::IdealMaps& out,
+                          const Array<double>* residentFitted, const Array<double>* residentTarget) {
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  if (fitted.size() != faceCount) {
+    throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faceCount) +
+               " faces");
+  }
+  if (target && target->rows() != source.rows()) {
+    throwUsage("closestIdealMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
+               std::to_string(target->rows()));
+  }
+  out.maps.resize(faceCount);
+  out.methods.resize(faceCount);
+  if (faceCount == 0) return;
+  checkFaces(faces, static_cast<Index>(source.rows()), "closestIdealMaps");
+
+  const std::size_t range = context_.info().maxStorageBufferRange;
+  const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
+  if (positionBytes > range || faces.indices().size() * sizeof(Index) > range) {
+    throwDevice("Vulkan: the mesh (" + std::to_string(source.rows()) + " vertices, " +
+                std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
+                std::to_string(range) + " bytes; use the CPU backend");
+  }
+  source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
+  // Without a target the shader never reads its binding, which still needs a buffer.
+  if (!target) residentTarget = nullptr;
+  if (!residentTarget) {
+    ensureCapacity(target_, context_, target ? static_cast<std::size_t>(target->size()) : 1, "target positions");
+    if (target) target_.upload({target->data(), static_cast<std::size_t>(target->size())});
+  }
+  const Array<double>& targetArray = residentTarget ? *residentTarget : target_;
+  offsets_.assign(context_, faces.offsets(), "face offsets");
+  indices_.assign(context_, faces.indices(), "face corners");
+
+  // Faces per chunk: the fitted and the ideal maps (128 bytes a face each) must fit one
+  // storage binding.
+  const std::size_t chunk = std::min(faceCount, range / kMapBytes);
+  if (chunk < faceCount || (residentFitted && residentFitted->count() < faceCount * 16)) residentFitted = nullptr;
+  if (!residentFitted) ensureCapacity(fitted_, context_, chunk * 16, "fitted maps");
+  const Array<double>& fittedArray = residentFitted ? *residentFitted : fitted_;
+  ensureCapacity(ideal_, context_, chunk * 16, "ideal maps");
+  ensureCapacity(methods_, context_, chunk, "ideal map methods");
+  DescriptorSet set(context_, pipeline_,
+                    {BufferRange(source_.array(), 0, positionBytes),
+                     BufferRange(targetArray, 0, target ? positionBytes : sizeof(double)),
+                     BufferRange(offsets_.array()), BufferRange(indices_.array()),
+                     BufferRange(fittedArray, 0, chunk * kMapBytes), BufferRange(ideal_, 0, chunk * kMapBytes),
+                     BufferRange(methods_, 0, chunk * sizeof(std::int32_t))});
+  Sequence sequence(context_);
+  for (std::size_t first = 0; first < faceCount; first += chunk) {
+    const std::size_t n = std::min(chunk, faceCount - first);
+    if (!residentFitted) fitted_.Buffer::upload(fitted.data() + first, n * kMapBytes);
+    sequence.begin();
+    sequence.dispatch(pipeline_, set,
+                      Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), target ? 1u : 0u,
+                           similar ? 1u : 0u},
+                      groupsFor(context_, n));
+    sequence.end();
+    sequence.run();
+    ideal_.Buffer::download(out.maps.data() + first, n * kMapBytes);
+    methods_.Buffer::download(out.methods.data() + first, n * sizeof(std::int32_t));
+  }
+}
+
+}  // namespace plano::vk

@@ -1,0 +1,196 @@
+// Vulkan batched closest ideal maps against the CPU reference (projective/IdealMapFit):
+// maps to 1e-10 and the same method per face, on fits of generated meshes under
+// perspective and random motions, rigid and similar, with the corner-set fallback.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "compute/VulkanFixture.h"
+#include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
+#include "mesh/Generators.h"
+#include "projective/IdealMaps.h"
+#include "projective/LocalStep.h"
+#include "projective/ProjectiveTestHelpers.h"
+
+namespace plano::test {
+namespace {
+
+struct IdealComparison {
+  double maps = 0.0;           ///< Largest |difference| / max(1, |entry|) over map entries.
+  int methodMismatches = 0;
+  Index fallbacks = 0;         ///< CPU faces with the corner-set Procrustes.
+  double largestRotation = 0.0;  ///< max |R - I| of the CPU maps' linear parts (a non-trivial example).
+};
+
+IdealComparison compare(compute::Backend& backend, const FaceList& faces, const Positions& source,
+                        const std::vector<Eigen::Matrix4d>& fitted, const Positions* target, bool similar) {
+  compute::IdealMaps gpu, cpu;
+  backend.closestIdealMaps(faces, source, fitted, target, similar, gpu);
+  compute::CpuBackend().closestIdealMaps(faces, source, fitted, target, similar, cpu);
+  IdealComparison c;
+  for (Index f = 0; f < faces.size(); ++f) {
+    for (int e = 0; e < 16; ++e) {
+      const double a = gpu.maps[f].data()[e], b = cpu.maps[f].data()[e];
+      c.maps = std::max(c.maps, std::abs(a - b) / std::max(1.0, std::abs(b)));
+    }
+    if (gpu.methods[f] != cpu.methods[f]) ++c.methodMismatches;
+    if (cpu.methods[f] == compute::IdealMapMethod::CornerProcrustes) ++c.fallbacks;
+    c.largestRotation = std::max(
+        c.largestRotation, (cpu.maps[f].topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+  }
+  return c;
+}
+
+/// The CPU fits of `target` (world) from the base mesh, in the shape space's coordinates.
+struct Fitted {
+  projective::ShapeSpace space;
+  std::vector<Eigen::Matrix4d> maps;
+  Positions normalizedTarget;
+};
+
+Fitted fit(const PolygonMesh& mesh, const Positions& target) {
+  Fitted out{projective::ShapeSpace(mesh), {}, {}};
+  compute::CpuBackend cpu;
+  out.maps = projective::fitFaceMaps(cpu, out.space, target).fits.maps;
+  out.normalizedTarget = out.space.normalization().toNormalized(target);
+  return out;
+}
+
+Positions rotatedScaledAndPerturbed(const Positions& x, double scale, double noise, unsigned seed) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, 1.0, -0.5).normalized()).toRotationMatrix();
+  Positions out = ((scale * x * R).rowwise() + Eigen::RowVector3d(0.3, -0.7, 1.1)).eval();
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, noise);
+  for (Eigen::Index i = 0; i < out.size(); ++i) out.data()[i] += normal(rng);
+  return out;
+}
+
+class VulkanIdealMaps : public VulkanTest {};
+
+TEST_F(VulkanIdealMaps, AgreeWithTheCpuOnPerspectiveFitsOfHexagonsRigidAndSimilar) {
+  const PolygonMesh mesh = generate::hexagonalDome(2);
+  const projective::ShapeSpace space(mesh);
+  const Positions target =
+      space.normalization().toWorld(applyProjectiveMap(space.basePositions(), samplePerspective()));
+  const Fitted f = fit(mesh, target);
+  for (const bool similar : {false, true}) {
+    for (const Positions* t : {static_cast<const Positions*>(nullptr), &f.normalizedTarget}) {
+      const IdealComparison c = compare(backend(), mesh.faces, f.space.basePositions(), f.maps, t, similar);
+      EXPECT_LT(c.maps, 1e-10) << "similar " << similar << ", target " << (t != nullptr);
+      EXPECT_EQ(c.methodMismatches, 0);
+      EXPECT_GT(c.largestRotation, 1e-2);  // the fits are not near the identity
+    }
+  }
+}
+
+TEST_F(VulkanIdealMaps, AgreeWithTheCpuOnFitsOfRandomlyMovedNonPlanarQuads) {
+  const PolygonMesh mesh = generate::translationalSurface(12, 9);
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    const Fitted f = fit(mesh, rotatedScaledAndPerturbed(mesh.vertices, 1.4, 0.02, seed));
+    for (const bool similar : {false, true}) {
+      const IdealComparison c =
+          compare(backend(), mesh.faces, f.space.basePositions(), f.maps, &f.normalizedTarget, similar);
+      EXPECT_LT(c.maps, 1e-10) << "seed " << seed << ", similar " << similar;
+      EXPECT_EQ(c.methodMismatches, 0);
+      EXPECT_GT(c.largestRotation, 0.1);
+    }
+  }
+}
+
+TEST_F(VulkanIdealMaps, FitsThroughThePlaneAtInfinityFallBackToCornerProcrustesAsOnTheCpu) {
+  const PolygonMesh mesh = generate::hexagonalDome(2);
+  const Fitted f = fit(mesh, rotatedScaledAndPerturbed(mesh.vertices, 0.8, 0.0, 4));
+  const Positions& p = f.space.basePositions();
+  // Every other face's fit changes weight sign across the face; the others stay the fits.
+  std::vector<Eigen::Matrix4d> broken = f.maps;
+  for (Index face = 0; face < mesh.faces.size(); face += 2) {
+    const auto corners = mesh.faces[face];
+    const Eigen::RowVector3d a = p.row(corners[0]);
+    const Eigen::RowVector3d b = p.row(corners[3]);
+    broken[face] = Eigen::Matrix4d::Identity();
+    broken[face].block<3, 1>(0, 3) = 1e3 * (b - a).transpose();
+    broken[face](3, 3) = 1.0 - 1e3 * (b - a).dot(0.5 * (a + b));
+  }
+  for (const bool similar : {false, true}) {
+    const IdealComparison c = compare(backend(), mesh.faces, p, broken, &f.normalizedTarget, similar);
+    EXPECT_LT(c.maps, 1e-10) << "similar " << similar;
+    EXPECT_EQ(c.methodMismatches, 0);
+    EXPECT_EQ(c.fallbacks, (mesh.faces.size() + 1) / 2);
+  }
+  // Without a target, a centroid at infinity is reported as on the CPU, and the operation of
+  // projective/IdealMaps.h names the face.
+  std::vector<Eigen::Matrix4d> atInfinity = f.maps;
+  Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+  for (const Index v : mesh.faces[1]) centroid += p.row(v);
+  centroid /= static_cast<double>(mesh.faces.degree(1));
+  atInfinity[1] = Eigen::Matrix4d::Identity();
+  atInfinity[1].block<3, 1>(0, 3) = Eigen::Vector3d(1.0, 0.0, 0.0);
+  atInfinity[1](3, 3) = -centroid.x();  // w(centroid) = x - x = 0
+  const IdealComparison none = compare(backend(), mesh.faces, p, atInfinity, nullptr, false);
+  EXPECT_EQ(none.methodMismatches, 0);
+  compute::IdealMaps gpu;
+  backend().closestIdealMaps(mesh.faces, p, atInfinity, nullptr, false, gpu);
+  EXPECT_EQ(gpu.methods[1], compute::IdealMapMethod::CentroidAtInfinity);
+  try {
+    projective::closestIdealMaps(backend(), f.space, atInfinity, projective::IdealMapKind::Rigid);
+    ADD_FAILURE() << "expected Error(Numerical)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("face 1 "), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VulkanIdealMaps, ARepeatedSourceAndTopologyStayOnTheDevice) {
+  const PolygonMesh mesh = generate::translationalSurface(6, 7);
+  const Fitted f = fit(mesh, rotatedScaledAndPerturbed(mesh.vertices, 1.1, 0.01, 5));
+  compute::IdealMaps out;
+  backend().closestIdealMaps(mesh.faces, f.space.basePositions(), f.maps, &f.normalizedTarget, true, out);
+  const vk::TransferCounts before = context().transfers();
+  backend().closestIdealMaps(mesh.faces, f.space.basePositions(), f.maps, &f.normalizedTarget, true, out);
+  const vk::TransferCounts after = context().transfers();
+  // Up: the fitted maps and the target; down: the ideal maps and the methods.
+  const auto faces = static_cast<std::uint64_t>(mesh.faces.size());
+  EXPECT_EQ(after.uploads - before.uploads, 2u);
+  EXPECT_EQ(after.uploadedBytes - before.uploadedBytes,
+            faces * 128u + static_cast<std::uint64_t>(mesh.vertices.size()) * 8u);
+  EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, faces * (128u + 4u));
+}
+
+TEST_F(VulkanIdealMaps, TheFitsOfTheLastLocalStepAndTheirTargetAreNotUploadedAgain) {
+  const PolygonMesh mesh = generate::translationalSurface(7, 6);
+  const projective::ShapeSpace space(mesh);
+  const Positions target = rotatedScaledAndPerturbed(mesh.vertices, 1.2, 0.01, 6);
+  const Positions normalized = space.normalization().toNormalized(target);
+  // A deformation's first iteration uploads the base mesh and topology to both kernels.
+  compute::IdealMaps warm;
+  backend().closestIdealMaps(mesh.faces, space.basePositions(),
+                             projective::fitFaceMaps(backend(), space, mesh.vertices).fits.maps, nullptr, false, warm);
+  // A later local step on this backend, then its ideal maps.
+  const projective::LocalStepResult fit = projective::fitFaceMaps(backend(), space, target);
+  const vk::TransferCounts before = context().transfers();
+  const IdealComparison c = compare(backend(), mesh.faces, space.basePositions(), fit.fits.maps, &normalized, false);
+  const vk::TransferCounts after = context().transfers();
+  EXPECT_LT(c.maps, 1e-10);
+  EXPECT_EQ(c.methodMismatches, 0);
+  EXPECT_EQ(after.uploads - before.uploads, 0u);
+  // Other maps than the fit's are uploaded, and the result is theirs.
+  std::vector<Eigen::Matrix4d> other = fit.fits.maps;
+  other[3](0, 1) += 0.05;
+  const IdealComparison changed = compare(backend(), mesh.faces, space.basePositions(), other, &normalized, false);
+  EXPECT_LT(changed.maps, 1e-10);
+  EXPECT_EQ(context().transfers().uploadedBytes - after.uploadedBytes, static_cast<std::uint64_t>(mesh.faces.size()) * 128u);
+}
+
+TEST_F(VulkanIdealMaps, AMapCountOtherThanTheFacesIsAUsageError) {
+  const PolygonMesh mesh = generate::cube();
+  std::vector<Eigen::Matrix4d> fewer(mesh.faces.size() - 1, Eigen::Matrix4d::Identity());
+  compute::IdealMaps out;
+  EXPECT_THROW(backend().closestIdealMaps(mesh.faces, mesh.vertices, fewer, nullptr, false, out), Error);
+  EXPECT_THROW(compute::CpuBackend().closestIdealMaps(mesh.faces, mesh.vertices, fewer, nullptr, false, out), Error);
+}
+
+}  // namespace
+}  // namespace plano::test
