@@ -45,11 +45,7 @@ void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::s
 
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
-  if (positionBytes > range || faces.indices().size() * sizeof(Index) > range) {
-    throwDevice("Vulkan: the mesh (" + std::to_string(source.rows()) + " vertices, " +
-                std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
-                std::to_string(range) + " bytes; use the CPU backend");
-  }
+  checkMeshFitsOneBinding(faces, static_cast<Index>(source.rows()), range);
   source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
   // Without a target the shader never reads its binding, which still needs a buffer.
   if (!target) residentTarget = nullptr;

@@ -21,4 +21,13 @@ void checkFaces(const FaceList& faces, Index vertexCount, const std::string& ope
   }
 }
 
+void checkMeshFitsOneBinding(const FaceList& faces, Index vertexCount, std::size_t maxStorageBufferRange) {
+  const std::size_t positionBytes = static_cast<std::size_t>(vertexCount) * 3 * sizeof(double);
+  if (positionBytes > maxStorageBufferRange || faces.indices().size() * sizeof(Index) > maxStorageBufferRange) {
+    throwDevice("Vulkan: the mesh (" + std::to_string(vertexCount) + " vertices, " +
+                std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
+                std::to_string(maxStorageBufferRange) + " bytes; use the CPU backend");
+  }
+}
+
 }  // namespace plano::vk

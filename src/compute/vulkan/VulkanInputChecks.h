@@ -12,4 +12,9 @@ namespace plano::vk {
 /// corners or a corner index outside [0, vertexCount). `operation` prefixes the message.
 void checkFaces(const FaceList& faces, Index vertexCount, const std::string& operation);
 
+/// Throws Error(Device) when a per-face kernel's whole-mesh bindings (the positions,
+/// #V x 3 doubles, or the corner indices) exceed one storage binding of `maxStorageBufferRange`
+/// bytes: such a mesh is for the CPU backend.
+void checkMeshFitsOneBinding(const FaceList& faces, Index vertexCount, std::size_t maxStorageBufferRange);
+
 }  // namespace plano::vk

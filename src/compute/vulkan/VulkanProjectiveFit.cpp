@@ -44,11 +44,7 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
 
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
-  if (positionBytes > range || faces.indices().size() * sizeof(Index) > range) {
-    throwDevice("Vulkan: the mesh (" + std::to_string(source.rows()) + " vertices, " +
-                std::to_string(faces.cornerCount()) + " corners) exceeds the device's storage-buffer range of " +
-                std::to_string(range) + " bytes; use the CPU backend");
-  }
+  checkMeshFitsOneBinding(faces, static_cast<Index>(source.rows()), range);
   source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
   target_.assign(context_, {target.data(), static_cast<std::size_t>(target.size())}, "target positions");
   lastMaps_.clear();
