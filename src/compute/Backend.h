@@ -54,6 +54,11 @@ struct IdealMaps {
   std::vector<IdealMapMethod> methods;   ///< #F.
 };
 
+/// Backend::closestIdealMaps's input checks, one for every backend: Error(Usage) unless
+/// `fitted` has one map per face and `target` (when given) as many rows as `source`.
+void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                         const Positions* target);
+
 /// Settings of an iterative or direct SPD solve.
 struct LinearSolverSettings {
   double relativeTolerance = 1e-10;  ///< Iterative solvers stop at ||r|| <= tol * ||b||.

@@ -12,6 +12,18 @@ std::optional<DeviceTransfers> transfersSince(const std::optional<DeviceTransfer
                          after->downloadedBytes - before->downloadedBytes, after->copies - before->copies};
 }
 
+void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                         const Positions* target) {
+  if (fitted.size() != static_cast<std::size_t>(faces.size())) {
+    throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faces.size()) +
+               " faces");
+  }
+  if (target && target->rows() != source.rows()) {
+    throwUsage("closestIdealMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
+               std::to_string(target->rows()));
+  }
+}
+
 BackendChoice parseBackendChoice(const std::string& text) {
   if (text == "cpu") return BackendChoice::Cpu;
   if (text == "vulkan") return BackendChoice::Vulkan;

@@ -184,12 +184,17 @@ TEST_F(VulkanIdealMaps, TheFitsOfTheLastLocalStepAndTheirTargetAreNotUploadedAga
   EXPECT_EQ(context().transfers().uploadedBytes - after.uploadedBytes, static_cast<std::uint64_t>(mesh.faces.size()) * 128u);
 }
 
-TEST_F(VulkanIdealMaps, AMapCountOtherThanTheFacesIsAUsageError) {
+TEST_F(VulkanIdealMaps, AMapCountOtherThanTheFacesOrATargetOfOtherSizeIsAUsageError) {
   const PolygonMesh mesh = generate::cube();
   std::vector<Eigen::Matrix4d> fewer(mesh.faces.size() - 1, Eigen::Matrix4d::Identity());
   compute::IdealMaps out;
   EXPECT_THROW(backend().closestIdealMaps(mesh.faces, mesh.vertices, fewer, nullptr, false, out), Error);
   EXPECT_THROW(compute::CpuBackend().closestIdealMaps(mesh.faces, mesh.vertices, fewer, nullptr, false, out), Error);
+  const std::vector<Eigen::Matrix4d> maps(mesh.faces.size(), Eigen::Matrix4d::Identity());
+  const Positions shortTarget = mesh.vertices.topRows(4);
+  EXPECT_THROW(backend().closestIdealMaps(mesh.faces, mesh.vertices, maps, &shortTarget, false, out), Error);
+  EXPECT_THROW(compute::CpuBackend().closestIdealMaps(mesh.faces, mesh.vertices, maps, &shortTarget, false, out),
+               Error);
 }
 
 }  // namespace

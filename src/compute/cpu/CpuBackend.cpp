@@ -121,11 +121,8 @@ void CpuBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std
 void CpuBackend::closestIdealMaps(const FaceList& faces, const Positions& source,
                                   std::span<const Eigen::Matrix4d> fitted, const Positions* target, bool similar,
                                   IdealMaps& out) {
+  checkIdealMapInputs(faces, source, fitted, target);
   const Index faceCount = faces.size();
-  if (static_cast<Index>(fitted.size()) != faceCount) {
-    throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faceCount) +
-               " faces");
-  }
   out.maps.resize(faceCount);
   out.methods.resize(faceCount);
   Eigen::Matrix<double, Eigen::Dynamic, 3> p, q;

@@ -29,15 +29,8 @@ IdealMapsKernel::IdealMapsKernel(Context& context)
 void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                           const Positions* target, bool similar, compute::IdealMaps& out,
                           const Array<double>* residentFitted, const Array<double>* residentTarget) {
+  compute::checkIdealMapInputs(faces, source, fitted, target);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
-  if (fitted.size() != faceCount) {
-    throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faceCount) +
-               " faces");
-  }
-  if (target && target->rows() != source.rows()) {
-    throwUsage("closestIdealMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
-               std::to_string(target->rows()));
-  }
   out.maps.resize(faceCount);
   out.methods.resize(faceCount);
   if (faceCount == 0) return;
