@@ -57,6 +57,12 @@ const char* toString(BoxQpStatus status) {
 BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, compute::SparseMatrix C,
                          const BoxQpSettings& settings)
     : backend_(backend), settings_(settings), P_(std::move(P)), C_(std::move(C)) {
+  if (!(settings_.polishRho >= 0.0) || std::isinf(settings_.polishRho)) {
+    throwUsage("box QP: the polish's rho must be a finite number >= 0 (0: automatic)");
+  }
+  if (settings_.polishRho == 0.0) {
+    settings_.polishRho = backend_.factorsSpdMatrices() ? kFactoredPolishRho : kIterativePolishRho;
+  }
   C_.makeCompressed();
   if (P_.rows() != P_.cols() || C_.cols() != P_.rows()) {
     throwUsage("box QP: P is " + std::to_string(P_.rows()) + "x" + std::to_string(P_.cols()) + " and C is " +
@@ -168,6 +174,7 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
       throwUsage("box QP: the ADMM's kernels declined a polish they had begun");
     }
     info.polishRefinements += refined.refinements;
+    info.linearIterations += refined.linearIterations;
     // The stiff polish system can be too ill-conditioned to form; polishing is an optional
     // refinement, so the ADMM's solution stands.
     if (!refined.factored) {

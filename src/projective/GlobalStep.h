@@ -84,7 +84,7 @@ struct GlobalStepInfo {
   double positionalResidual = 0.0;   ///< max |C_s A - d| over positional rows.
   int admmIterations = 0;            ///< Summed over the attempts.
   int factorizations = 0;
-  long linearIterations = 0;         ///< Of the ADMM's solves with K, summed (BoxQpInfo).
+  long linearIterations = 0;         ///< Of the ADMM's (and device polish's) solves, summed (BoxQpInfo).
   bool polished = false;
   /// Of the accepted attempt's polish or direct equality solve (BoxQpInfo::polishRefinements).
   int polishRefinements = 0;

@@ -644,12 +644,9 @@ void AdmmKernels::recordRightHandSide(Sequence& s) {
   s.barrier();
 }
 
-void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations) {
+void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
-  const std::uint32_t k = w.k;
-  const std::uint32_t nk = n_ * k;
-
   // PCG start from xTilde: r = rhs - K xTilde, preconditioned = M^-1 r, p = it, r.z, r.r, b.z.
   la.spmv(s, devK_, w.xTilde, w.Kp);
   la.copy(s, w.rhs, w.r);
@@ -662,12 +659,28 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations) {
   la.copy(s, w.preconditioned, w.p);
   la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
   la.dot(s, w.r, w.r, w.pcg, kRrEven);
-  if (multigrid_) {  // Kp as scratch for M^-1 b
-    multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
-  } else {
-    la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
+  if (target == SolveTarget::WarmStart) {
+    la.dot(s, w.r, w.preconditioned, w.pcg, kBz);
+  } else if (target == SolveTarget::RightHandSide) {
+    if (multigrid_) {  // Kp as scratch for M^-1 b
+      multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
+    } else {
+      la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
+    }
+    la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
   }
-  la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
+}
+
+void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd) {
+  Workspace& w = *workspace_;
+  const std::uint32_t k = w.k;
+  const std::uint32_t nk = n_ * k;
+
+  // A continuation's first iterate is the one the last run's capped solve reached: in the
+  // slot that run's parity (its recorded count, `firstOdd`) left its r.z in.
+  const bool continuation = target == SolveTarget::Continuation;
+  const int parity = continuation && firstOdd ? 1 : 0;
+  if (!continuation) recordPcgStart(s, target);
 
   const std::uint32_t groups = w.pcg.groups();
   const std::uint32_t directionGroups = groupsFor(context_, nk);
@@ -677,11 +690,11 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations) {
                1);
     s.barrier();
   };
-  control(0, kRzEven);
+  control(continuation ? 1 : 0, parity == 0 ? kRzEven : kRzOdd);
   for (int j = 0; j < innerIterations; ++j) {
     // The iteration of vk::PcgSolver; r.z alternates between two slots.
-    const std::uint32_t current = j % 2 == 0 ? kRzEven : kRzOdd;
-    const std::uint32_t next = j % 2 == 0 ? kRzOdd : kRzEven;
+    const std::uint32_t current = (j + parity) % 2 == 0 ? kRzEven : kRzOdd;
+    const std::uint32_t next = (j + parity) % 2 == 0 ? kRzOdd : kRzEven;
     s.dispatchIndirect(spmvDot_, *w.spmvDotSet, PcgSpmvDotPush{n_}, w.arguments, kFusedArguments);
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
@@ -935,12 +948,12 @@ void AdmmKernels::recordPolish() {
   p.solve.begin();
   recordRightHandSide(p.solve);
   la.copy(p.solve, w.x, w.xTilde);
-  recordInnerSolve(p.solve, cap);
+  recordInnerSolve(p.solve, cap, SolveTarget::WarmStart);
   p.solve.end();
-  // A solve that needs more goes on with the ADMM's longest recording: a PCG restarted
+  // A solve that needs more continues where it stopped, not restarted: a PCG restarted
   // every few dozen iterations converges far slower on the stiff K_A.
   p.resume.begin();
-  recordInnerSolve(p.resume, std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations)));
+  recordInnerSolve(p.resume, kPolishResumeIterations, SolveTarget::Continuation, cap % 2 == 1);
   p.resume.end();
   // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
   // lambda reaches it).

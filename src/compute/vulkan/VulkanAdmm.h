@@ -66,11 +66,16 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// cap bounds the recording's size (empty dispatches are not free).
   static constexpr int kInitialInnerIterations = 256;
   static constexpr int kMaxInnerIterations = 1024;
-  /// Recorded PCG iterations per run of a polish solve (refineActiveSet), which resumes
-  /// from its iterate until the solve converges: warm-started at the ADMM's solution those
-  /// solves need tens of iterations, and the recorded ones past convergence still cost
-  /// their (empty) dispatches.
+  /// Recorded PCG iterations per run of a polish solve (refineActiveSet), which continues
+  /// until the solve converges: the recorded ones past convergence still cost their
+  /// (empty) dispatches. Warm-started at the ADMM's solution a solve that only needs to
+  /// meet tol ||b|| takes tens of iterations; one to tol ||r0|| (SolveTarget::WarmStart)
+  /// hundreds (8x8 grid deformation: about 800 per polish).
   static constexpr int kPolishInnerIterations = 64;
+  /// Recorded PCG iterations of each continuation of a polish solve past that cap (even:
+  /// a continuation keeps the parity of the r.z slots).
+  static constexpr int kPolishResumeIterations = 128;
+  static_assert(kPolishResumeIterations % 2 == 0);
   /// Automatic recording uses one workgroup up to this many unknowns per column: one
   /// workgroup then sweeps a vector in at most a few hundred rows per invocation.
   static constexpr std::uint32_t kSingleWorkgroupUnknowns = 1u << 16;
@@ -153,7 +158,22 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// and forming relaxed bounds as asked.
   void recordStart(Sequence& s, StartX xStart, bool zeroY, bool relaxedBounds);
   void recordRightHandSide(Sequence& s);
-  void recordInnerSolve(Sequence& s, int innerIterations);
+  /// What an inner PCG solve's relative tolerance is relative to.
+  enum class SolveTarget {
+    RightHandSide,  ///< ||r|| <= tol ||b||: the ADMM's solves.
+    /// ||r|| <= tol ||r0||, r0 the warm start's residual: the polish's solves, whose b is
+    /// dominated by the stiff rho_P C^T b term (1e9), so that tol ||b|| left the answer's
+    /// soft directions (those C does not fix, where the objective decides) an error
+    /// of 1e-6 of the mesh size after the polish (8x8 grid deformation, lavapipe).
+    WarmStart,
+    /// No start: the last run's solve, stopped by its recorded cap, goes on with its
+    /// iterate, direction and target. That run recorded an odd count when `firstOdd`.
+    Continuation,
+  };
+  /// r = b - K xTilde, its preconditioned residual and the stopping target's b.z.
+  void recordPcgStart(Sequence& s, SolveTarget target);
+  void recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target = SolveTarget::RightHandSide,
+                        bool firstOdd = false);
   void recordIteration(Sequence& s, bool saveDual, int innerIterations);
   void recordPolish();
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
