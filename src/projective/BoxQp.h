@@ -43,7 +43,7 @@ enum class EqualitySolve {
   Direct,
   Admm,  ///< The ADMM, then the polish, as for any other problem.
   /// Direct where the backend factors SPD matrices (Backend::factorsSpdMatrices), the ADMM
-  /// on an iterative backend: there the polish's stiff system (rhoP = 1e9) from a cold
+  /// on an iterative backend: there the polish's stiff system (rhoP = 1e9 when measured) from a cold
   /// start needs PCG iterations that grow fast with the mesh. Measured on lavapipe with
   /// face-block PCG, direct vs ADMM global step: 64 faces 0.71 vs 1.25 s, 256 faces 8.4
   /// vs 8.0 s, 1k faces a solve did not converge within 10 000 iterations (the fallback

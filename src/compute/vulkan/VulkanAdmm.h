@@ -70,7 +70,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// until the solve converges: the recorded ones past convergence still cost their
   /// (empty) dispatches. Warm-started at the ADMM's solution a solve that only needs to
   /// meet tol ||b|| takes tens of iterations; one to tol ||r0|| (SolveTarget::WarmStart)
-  /// hundreds (8x8 grid deformation: about 800 per polish).
+  /// hundreds (8x8 grid deformation: about 2 600 per polish of 5-7 refinements).
   static constexpr int kPolishInnerIterations = 64;
   /// Recorded PCG iterations of each continuation of a polish solve past that cap (even:
   /// a continuation keeps the parity of the r.z slots).
@@ -162,9 +162,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   enum class SolveTarget {
     RightHandSide,  ///< ||r|| <= tol ||b||: the ADMM's solves.
     /// ||r|| <= tol ||r0||, r0 the warm start's residual: the polish's solves, whose b is
-    /// dominated by the stiff rho_P C^T b term (1e9), so that tol ||b|| left the answer's
-    /// soft directions (those C does not fix, where the objective decides) an error
-    /// of 1e-6 of the mesh size after the polish (8x8 grid deformation, lavapipe).
+    /// dominated by the stiff rho_P C^T b term, so that tol ||b|| left the answer's soft
+    /// directions (those C does not fix, where the objective decides) an error of 1e-6 of
+    /// the mesh size after the polish (8x8 grid deformation, lavapipe, rho_P then 1e9).
     WarmStart,
     /// No start: the last run's solve, stopped by its recorded cap, goes on with its
     /// iterate, direction and target. That run recorded an odd count when `firstOdd`.
