@@ -4,7 +4,9 @@
 // indirect dispatch sizes of that iteration: its full sizes while some column still has
 // r.z > tol^2 b.z or r.r > abs^2, zero once all have converged, so the rest of the
 // recorded iterations cost empty dispatches and the solution is that of a PCG stopped at
-// the tolerance. NaN counts as not converged, so that it reaches the iterate. state: [0]
+// the tolerance, or (where slotFloor names b.z's slot) once r.z <= floor^2 b.z, the
+// rounding floor of a solve whose own target is relative to its warm start's residual.
+// NaN counts as not converged, so that it reaches the iterate. state: [0]
 // done flag of this solve, [1] iterations run, [2] solves stopped by the recorded cap,
 // [3] abs^2, an absolute bound the host derives from the ADMM's residuals (compute/Admm.h).
 #extension GL_GOOGLE_include_directive : require
@@ -23,9 +25,10 @@ layout(push_constant) uniform Push {
   uint mode;  // 0: first check of a solve, 1: later check, 2: after the last recorded iteration
   uint groupsColumn;     // workgroups per column of the fused PCG kernels
   uint groupsDirection;  // workgroups of the direction update
-  uint pad0;
-  uint pad1;
+  uint slotFloor;  // b.z of the right-hand side for the rounding floor; ~0u: none
+  uint pad;
   double tolerance2;
+  double floor2;
 } pc;
 
 void main() {
@@ -35,7 +38,9 @@ void main() {
     bool any = false;
     for (uint c = 0; c < pc.m; ++c) {
       const double rz = scalars[pc.slotRz * pc.m + c], rr = scalars[(pc.slotRz + 1) * pc.m + c];
-      if (!(rz <= pc.tolerance2 * scalars[pc.slotBz * pc.m + c]) || !(rr <= state[3])) any = true;
+      const bool reached = rz <= pc.tolerance2 * scalars[pc.slotBz * pc.m + c] ||
+                           (pc.slotFloor != ~0u && rz <= pc.floor2 * scalars[pc.slotFloor * pc.m + c]);
+      if (!reached || !(rr <= state[3])) any = true;
     }
     running = any;
   }

@@ -16,9 +16,10 @@ namespace {
 
 // Push constants of the ADMM kernels (layouts of the shaders' Push blocks).
 struct ControlPush {
-  std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, pad0, pad1;
-  double tolerance2;
+  std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, slotFloor, pad;
+  double tolerance2, floor2;
 };
+constexpr std::uint32_t kNoFloor = ~0u;
 struct RhsPush {
   std::uint32_t rows, count, mode, pad;
   double sigma;
@@ -49,7 +50,9 @@ struct SingleWorkgroupPush {
 
 // PCG scalar slots (k values each). r.r follows its r.z: pcg_step's paired reduction
 // writes both.
-enum PcgSlot : std::uint32_t { kRzEven = 0, kRrEven, kRzOdd, kRrOdd, kPq, kBz, kPcgSlots };
+// kBz scales the stopping test (b.z of the right-hand side, or of the warm start's residual);
+// kRhsBz is b.z where it scales only the rounding floor (the polish's solves).
+enum PcgSlot : std::uint32_t { kRzEven = 0, kRrEven, kRzOdd, kRrOdd, kPq, kBz, kRhsBz, kPcgSlots };
 // Check scalar slots (k values each), in AdmmMeasures' order.
 enum MeasureSlot : std::uint32_t {
   kPrimal = 0, kDual, kCx, kZ, kPx, kCty, kQ, kX, kY, kDy, kCtdy, kSupport, kMeasureSlots
@@ -659,16 +662,13 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   la.copy(s, w.preconditioned, w.p);
   la.dot(s, w.r, w.preconditioned, w.pcg, kRzEven);
   la.dot(s, w.r, w.r, w.pcg, kRrEven);
-  if (target == SolveTarget::WarmStart) {
-    la.dot(s, w.r, w.preconditioned, w.pcg, kBz);
-  } else if (target == SolveTarget::RightHandSide) {
-    if (multigrid_) {  // Kp as scratch for M^-1 b
-      multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
-    } else {
-      la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
-    }
-    la.dot(s, w.rhs, w.Kp, w.pcg, kBz);
+  if (target == SolveTarget::WarmStart) la.dot(s, w.r, w.preconditioned, w.pcg, kBz);
+  if (multigrid_) {  // Kp as scratch for M^-1 b
+    multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
+  } else {
+    la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
   }
+  la.dot(s, w.rhs, w.Kp, w.pcg, target == SolveTarget::RightHandSide ? kBz : kRhsBz);
 }
 
 void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd) {
@@ -685,9 +685,12 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   const std::uint32_t groups = w.pcg.groups();
   const std::uint32_t directionGroups = groupsFor(context_, nk);
   const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
+  // The polish's solves (tol ||r0||) stop at the rounding floor of ||b|| too.
+  const std::uint32_t floorSlot = target == SolveTarget::RightHandSide ? kNoFloor : kRhsBz;
+  const double floor2 = kPolishRoundingFloor * kPolishRoundingFloor;
   auto control = [&](std::uint32_t mode, std::uint32_t slotRz) {
-    s.dispatch(control_, *w.controlSet, ControlPush{k, slotRz, kBz, mode, groups, directionGroups, 0, 0, tolerance2},
-               1);
+    s.dispatch(control_, *w.controlSet,
+               ControlPush{k, slotRz, kBz, mode, groups, directionGroups, floorSlot, 0, tolerance2, floor2}, 1);
     s.barrier();
   };
   control(continuation ? 1 : 0, parity == 0 ? kRzEven : kRzOdd);
@@ -1042,7 +1045,7 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     w.state.download(state);
     while (state[kCappedSolves] > capped && state[kInnerIterations] - solveStart < maxIterations) {
       capped = state[kCappedSolves];
-      p.resume.run();  // restarts PCG from the iterate reached
+      p.resume.run();  // continues the PCG where the capped run stopped
       w.state.download(state);
     }
     if (state[kCappedSolves] > capped) info.solvesConverged = false;
