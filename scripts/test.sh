@@ -12,18 +12,28 @@ stages=" ${PLANO_TEST_STAGES:-release sanitize fuzz} "
 # Without a GPU, the Vulkan tests run on Mesa's lavapipe.
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
 
+# Each step's wall time, printed at the end: what a slower CI run spent its time on.
+timings=""
+timed() {
+  local label="$1" start=$SECONDS
+  shift
+  "$@"
+  timings+="$label: $((SECONDS - start)) s"$'\n'
+}
+
 if [[ "$stages" == *" release "* ]]; then
   echo "== stage 1/3: release build and tests" >&2
   BUILD_DIR=${PLANO_BUILD_DIR:-build}
   cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$BUILD_DIR" -j"$(nproc)"
-  ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)"
+  timed "release build" cmake --build "$BUILD_DIR" -j"$(nproc)"
+  timed "release tests" ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)"
 fi
 if [[ "$stages" == *" sanitize "* ]]; then
   echo "== stage 2/3: AddressSanitizer + UndefinedBehaviorSanitizer build and tests" >&2
-  bash scripts/sanitize.sh
+  timed "sanitizer build and tests" bash scripts/sanitize.sh
 fi
 if [[ "$stages" == *" fuzz "* ]]; then
   echo "== stage 3/3: fuzz smoke run" >&2
-  bash scripts/fuzz.sh "${PLANO_FUZZ_SECONDS:-30}"
+  timed "fuzz build and run" bash scripts/fuzz.sh "${PLANO_FUZZ_SECONDS:-30}"
 fi
+printf "== wall time per step\n%s" "$timings" >&2
