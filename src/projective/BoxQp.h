@@ -61,7 +61,8 @@ inline constexpr double kFactoredPolishRho = 1e9;
 /// left in those directions. Measured on lavapipe, the 8x8 grid's ε = 0 global step against
 /// its KKT solution (max entry error; PCG iterations of ADMM + polish): rho 1e9 6.4e-8
 /// (7 637), 1e7 9.6e-10 (7 812), 1e6 1.3e-10 (6 680), 1e5 8.0e-12 (7 128, 7
-/// refinements), 1e4 9.2e-13 (8 290, 16 refinements).
+/// refinements), 1e4 9.2e-13 (8 290, 16 refinements); 1e5 with the device polish's rounding
+/// floor (vk::AdmmKernels::kPolishRoundingFloor) 1.1e-11 (5 629).
 inline constexpr double kIterativePolishRho = 1e5;
 
 /// The ADMM's settings (compute::AdmmSettings) and those of the final polish.
