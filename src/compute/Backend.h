@@ -59,6 +59,10 @@ struct IdealMaps {
 void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                          const Positions* target);
 
+/// Backend::fitProjectiveMaps's input check, one for every backend: Error(Usage) unless
+/// `target` has as many rows as `source`.
+void checkFitInputs(const Positions& source, const Positions& target);
+
 /// Settings of an iterative or direct SPD solve.
 struct LinearSolverSettings {
   double relativeTolerance = 1e-10;  ///< Iterative solvers stop at ||r|| <= tol * ||b||.
@@ -143,6 +147,14 @@ class Backend {
   /// may be null). `fitted` has #F entries (Error(Usage) otherwise).
   virtual void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                                 const Positions* target, bool similar, IdealMaps& out) = 0;
+
+  /// The local step of a rigid or similar deformation in one call: fitProjectiveMaps from
+  /// `source` to `target`, then closestIdealMaps of those fits with `target` as the corner
+  /// fallback's positions. The fits themselves are not returned: a device backend keeps
+  /// them where the next kernel reads them instead of copying them to the host and back.
+  /// The default runs the two calls.
+  virtual void fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+                            IdealMaps& out);
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;

@@ -12,6 +12,13 @@ std::optional<DeviceTransfers> transfersSince(const std::optional<DeviceTransfer
                          after->downloadedBytes - before->downloadedBytes, after->copies - before->copies};
 }
 
+void checkFitInputs(const Positions& source, const Positions& target) {
+  if (source.rows() != target.rows()) {
+    throwUsage("fitProjectiveMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
+               std::to_string(target.rows()));
+  }
+}
+
 void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                          const Positions* target) {
   if (fitted.size() != static_cast<std::size_t>(faces.size())) {
@@ -22,6 +29,13 @@ void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::sp
     throwUsage("closestIdealMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
                std::to_string(target->rows()));
   }
+}
+
+void Backend::fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+                           IdealMaps& out) {
+  ProjectiveFits fits;
+  fitProjectiveMaps(faces, source, target, fits);
+  closestIdealMaps(faces, source, fits.maps, &target, similar, out);
 }
 
 BackendChoice parseBackendChoice(const std::string& text) {

@@ -78,9 +78,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       throwIfCancelled("deformation");
       transfersBefore = backend_.transfers();
-      const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
-      const Positions normalized = space_.normalization().toNormalized(positions);
-      const auto ideal = closestIdealMaps(backend_, space_, fit.fits.maps, settings_.energy, &normalized);
+      const auto ideal = fittedIdealMaps(backend_, space_, positions, settings_.energy);
       const GlobalStepInfo step = global_.solve(ideal, targets, maps);
       const Positions next = space_.positions(maps.maps);
       const DeformationIteration it = record(DeformationPhase::Ideal, step, next);

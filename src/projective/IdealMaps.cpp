@@ -3,8 +3,31 @@
 #include <string>
 
 #include "core/Error.h"
+#include "projective/LocalStep.h"
 
 namespace plano::projective {
+namespace {
+
+/// The maps of a batched ideal-map call, after counting the corner fallbacks and refusing a
+/// face whose centroid the fit sends to infinity (no ideal map then).
+std::vector<Eigen::Matrix4d> checkedMaps(compute::IdealMaps ideal, Index* fallbacks) {
+  const auto faceCount = static_cast<Index>(ideal.maps.size());
+  if (fallbacks) *fallbacks = 0;
+  for (Index f = 0; f < faceCount; ++f) {
+    switch (ideal.methods[f]) {
+      case compute::IdealMapMethod::Jacobian: break;
+      case compute::IdealMapMethod::CornerProcrustes:
+        if (fallbacks) ++*fallbacks;
+        break;
+      case compute::IdealMapMethod::CentroidAtInfinity:
+        throwNumerical("closest ideal map: the fitted map of face " + std::to_string(f) +
+                       " sends the face centroid to infinity");
+    }
+  }
+  return std::move(ideal.maps);
+}
+
+}  // namespace
 
 std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const ShapeSpace& space,
                                               const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind,
@@ -21,19 +44,15 @@ std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const S
   compute::IdealMaps ideal;
   backend.closestIdealMaps(space.faces(), space.basePositions(), fitted, target, kind == IdealMapKind::Similar,
                            ideal);
-  if (fallbacks) *fallbacks = 0;
-  for (Index f = 0; f < faceCount; ++f) {
-    switch (ideal.methods[f]) {
-      case compute::IdealMapMethod::Jacobian: break;
-      case compute::IdealMapMethod::CornerProcrustes:
-        if (fallbacks) ++*fallbacks;
-        break;
-      case compute::IdealMapMethod::CentroidAtInfinity:
-        throwNumerical("closest ideal map: the fitted map of face " + std::to_string(f) +
-                       " sends the face centroid to infinity");
-    }
-  }
-  return std::move(ideal.maps);
+  return checkedMaps(std::move(ideal), fallbacks);
+}
+
+std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const ShapeSpace& space,
+                                             const Positions& target, IdealMapKind kind, Index* fallbacks) {
+  const Positions normalizedTarget = normalizedTargetPositions(space, target);
+  compute::IdealMaps ideal;
+  backend.fitIdealMaps(space.faces(), space.basePositions(), normalizedTarget, kind == IdealMapKind::Similar, ideal);
+  return checkedMaps(std::move(ideal), fallbacks);
 }
 
 }  // namespace plano::projective

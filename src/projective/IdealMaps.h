@@ -46,4 +46,12 @@ std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const S
                                               const std::vector<Eigen::Matrix4d>& fitted, IdealMapKind kind,
                                               const Positions* target = nullptr, Index* fallbacks = nullptr);
 
+/// The local step of rigid or similar deformation (§6.1) in one backend call
+/// (Backend::fitIdealMaps): the projective fit of every face from the base mesh to
+/// `target` (#V x 3, world coordinates; fitFaceMaps's checks), then its closest ideal map
+/// as closestIdealMaps with the normalized target as the corner fallback's positions. The
+/// fits are not returned, so a device backend keeps them on the device.
+std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const ShapeSpace& space,
+                                             const Positions& target, IdealMapKind kind, Index* fallbacks = nullptr);
+
 }  // namespace plano::projective

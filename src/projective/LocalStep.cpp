@@ -7,7 +7,7 @@
 
 namespace plano::projective {
 
-LocalStepResult fitFaceMaps(compute::Backend& backend, const ShapeSpace& space, const Positions& target) {
+Positions normalizedTargetPositions(const ShapeSpace& space, const Positions& target) {
   if (target.rows() != space.vertexCount()) {
     throwBadInput("local step: target has " + std::to_string(target.rows()) + " vertices, the base mesh " +
                   std::to_string(space.vertexCount()));
@@ -17,7 +17,11 @@ LocalStepResult fitFaceMaps(compute::Backend& backend, const ShapeSpace& space, 
       throwBadInput("local step: target vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
   }
-  const Positions normalizedTarget = space.normalization().toNormalized(target);
+  return space.normalization().toNormalized(target);
+}
+
+LocalStepResult fitFaceMaps(compute::Backend& backend, const ShapeSpace& space, const Positions& target) {
+  const Positions normalizedTarget = normalizedTargetPositions(space, target);
   compute::ProjectiveFits fits;
   backend.fitProjectiveMaps(space.faces(), space.basePositions(), normalizedTarget, fits);
 

@@ -159,8 +159,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     const double coarseDiagonal = coarseSpace.normalization().scale;
     for (int it = 0; it < settings.maxCoarseIterations && !converged; ++it) {
       throwIfCancelled("multi-resolution deformation");
-      const LocalStepResult fit = fitFaceMaps(backend, coarseSpace, current);
-      const auto ideal = closestIdealMaps(backend, coarseSpace, fit.fits.maps, settings.energy);
+      const auto ideal = fittedIdealMaps(backend, coarseSpace, current, settings.energy);
       const GlobalStepInfo step = coarseStep.solve(ideal, coarseMaps);
       const Positions next = coarseSpace.positions(coarseMaps.maps);
       const double displacement = maxRowDistance(next, current) / coarseDiagonal;

@@ -184,6 +184,65 @@ TEST_F(VulkanIdealMaps, TheFitsOfTheLastLocalStepAndTheirTargetAreNotUploadedAga
   EXPECT_EQ(context().transfers().uploadedBytes - after.uploadedBytes, static_cast<std::uint64_t>(mesh.faces.size()) * 128u);
 }
 
+TEST_F(VulkanIdealMaps, TheFusedLocalStepAgreesWithTheCpuAndBringsBackOnlyTheIdealMaps) {
+  const PolygonMesh mesh = generate::translationalSurface(7, 6);
+  const projective::ShapeSpace space(mesh);
+  const auto faces = static_cast<std::uint64_t>(mesh.faces.size());
+  for (const unsigned seed : {7u, 8u}) {
+    const Positions target =
+        space.normalization().toNormalized(rotatedScaledAndPerturbed(mesh.vertices, 1.3, 0.02, seed));
+    for (const bool similar : {false, true}) {
+      compute::IdealMaps cpu;
+      compute::CpuBackend().fitIdealMaps(mesh.faces, space.basePositions(), target, similar, cpu);
+      compute::IdealMaps warm;  // the base mesh and topology reach the device once
+      backend().fitIdealMaps(mesh.faces, space.basePositions(), space.basePositions(), similar, warm);
+      const vk::TransferCounts before = context().transfers();
+      compute::IdealMaps gpu;
+      backend().fitIdealMaps(mesh.faces, space.basePositions(), target, similar, gpu);
+      const vk::TransferCounts after = context().transfers();
+      double largest = 0.0, rotation = 0.0;
+      for (Index f = 0; f < mesh.faces.size(); ++f) {
+        largest = std::max(largest, (gpu.maps[f] - cpu.maps[f]).cwiseAbs().maxCoeff());
+        rotation = std::max(rotation, (cpu.maps[f].topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).norm());
+        EXPECT_EQ(gpu.methods[f], cpu.methods[f]) << "face " << f;
+      }
+      EXPECT_LT(largest, 1e-10) << "seed " << seed << ", similar " << similar;
+      EXPECT_GT(rotation, 0.1);  // far from the identity: the comparison means something
+      // Up: the target positions, once; down: the ideal maps and their methods, no fit.
+      EXPECT_EQ(after.uploads - before.uploads, 1u);
+      EXPECT_EQ(after.uploadedBytes - before.uploadedBytes, static_cast<std::uint64_t>(target.size()) * 8u);
+      EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, faces * (128u + 4u));
+    }
+  }
+  // A separate fit and ideal-map call bring the fits back as well (maps, scales, residuals,
+  // ranks): what the fused step saves.
+  const Positions target = space.normalization().toNormalized(rotatedScaledAndPerturbed(mesh.vertices, 1.3, 0.02, 9));
+  const vk::TransferCounts before = context().transfers();
+  compute::ProjectiveFits fits;
+  backend().fitProjectiveMaps(mesh.faces, space.basePositions(), target, fits);
+  compute::IdealMaps separate;
+  backend().closestIdealMaps(mesh.faces, space.basePositions(), fits.maps, &target, false, separate);
+  const vk::TransferCounts after = context().transfers();
+  EXPECT_EQ(after.downloadedBytes - before.downloadedBytes,
+            faces * (128u + 4u) + faces * (128u + 8u + 4u) + static_cast<std::uint64_t>(mesh.faces.cornerCount()) * 8u);
+}
+
+TEST_F(VulkanIdealMaps, TheFusedLocalStepOfATargetOfOtherSizeIsAUsageErrorOnBothBackends) {
+  const PolygonMesh mesh = generate::cube();
+  const Positions shortTarget = mesh.vertices.topRows(4);
+  compute::IdealMaps out;
+  for (compute::Backend* b : {static_cast<compute::Backend*>(&backend()), static_cast<compute::Backend*>(nullptr)}) {
+    compute::CpuBackend cpu;
+    compute::Backend& on = b ? *b : cpu;
+    try {
+      on.fitIdealMaps(mesh.faces, mesh.vertices, shortTarget, false, out);
+      ADD_FAILURE() << on.name() << ": expected Error(Usage)";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage) << e.what();
+    }
+  }
+}
+
 TEST_F(VulkanIdealMaps, AMapCountOtherThanTheFacesOrATargetOfOtherSizeIsAUsageError) {
   const PolygonMesh mesh = generate::cube();
   std::vector<Eigen::Matrix4d> fewer(mesh.faces.size() - 1, Eigen::Matrix4d::Identity());

@@ -81,6 +81,7 @@ void CpuBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out) {
 
 void CpuBackend::fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
                                    ProjectiveFits& out) {
+  checkFitInputs(source, target);
   const Index faceCount = faces.size();
   out.maps.resize(faceCount);
   out.reciprocalScales.resize(faces.cornerCount());

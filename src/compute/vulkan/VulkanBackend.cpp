@@ -55,6 +55,18 @@ void VulkanBackend::closestIdealMaps(const FaceList& faces, const Positions& sou
   idealMaps_->run(faces, source, fitted, target, similar, out, residentFitted, residentTarget);
 }
 
+void VulkanBackend::fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+                                 IdealMaps& out) {
+  if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
+  const vk::Array<double>* fits = projectiveFit_->runResident(faces, source, target);
+  if (!fits) {  // no faces, or more maps than one binding holds
+    Backend::fitIdealMaps(faces, source, target, similar, out);
+    return;
+  }
+  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_);
+  idealMaps_->runOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
+}
+
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
   return std::make_unique<vk::PcgSolver>(*context_, A, settings);
 }

@@ -36,6 +36,9 @@ class VulkanBackend final : public Backend {
                         std::span<Eigen::Vector3d> singularValues) override;
   void closestIdealMaps(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                         const Positions* target, bool similar, IdealMaps& out) override;
+  /// The fits stay on the device: only the ideal maps come back.
+  void fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+                    IdealMaps& out) override;
   /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;

@@ -30,6 +30,28 @@ void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::s
                           const Positions* target, bool similar, compute::IdealMaps& out,
                           const Array<double>* residentFitted, const Array<double>* residentTarget) {
   compute::checkIdealMapInputs(faces, source, fitted, target);
+  mapChunks(faces, source, fitted, target, similar, out, residentFitted, residentTarget);
+}
+
+void IdealMapsKernel::runOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
+                                        const Positions& target, const Array<double>* residentTarget, bool similar,
+                                        compute::IdealMaps& out) {
+  if (target.rows() != source.rows()) {
+    throwUsage("closestIdealMaps: target has " + std::to_string(target.rows()) + " vertices, source " +
+               std::to_string(source.rows()));
+  }
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  const std::size_t range = context_.info().maxStorageBufferRange;
+  if (fitted.count() < faceCount * 16 || faceCount > range / kMapBytes) {
+    throwUsage("closestIdealMaps: the resident fits do not hold the maps of all " + std::to_string(faceCount) +
+               " faces in one binding");
+  }
+  mapChunks(faces, source, {}, &target, similar, out, &fitted, residentTarget);
+}
+
+void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+                              const Positions* target, bool similar, compute::IdealMaps& out,
+                              const Array<double>* residentFitted, const Array<double>* residentTarget) {
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   out.maps.resize(faceCount);
   out.methods.resize(faceCount);

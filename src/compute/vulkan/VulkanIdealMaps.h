@@ -22,8 +22,20 @@ class IdealMapsKernel {
   void run(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
            const Positions* target, bool similar, compute::IdealMaps& out,
            const Array<double>* residentFitted = nullptr, const Array<double>* residentTarget = nullptr);
+  /// The same for fits that exist only on the device (vk::ProjectiveFitKernel::runResident:
+  /// a deformation's local step, whose fits never cross to the host), with `target` the
+  /// positions they were fitted to (`residentTarget`, when not null, the device array that
+  /// holds it). Throws Error(Usage) when `fitted` does not hold #F maps in one binding.
+  void runOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
+                         const Positions& target, const Array<double>* residentTarget, bool similar,
+                         compute::IdealMaps& out);
 
  private:
+  /// Both runs, after their input checks: `fitted` is read only without `residentFitted`.
+  void mapChunks(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
+               const Positions* target, bool similar, compute::IdealMaps& out, const Array<double>* residentFitted,
+               const Array<double>* residentTarget);
+
   Context& context_;
   Pipeline pipeline_;
   // Reused across calls (grow-only): a deformation loop allocates once and uploads its

@@ -30,38 +30,52 @@ ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings
 
 void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
                               compute::ProjectiveFits& out) {
-  if (source.rows() != target.rows()) {
-    throwUsage("fitProjectiveMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
-               std::to_string(target.rows()));
-  }
+  fit(faces, source, target, &out);
+}
+
+const Array<double>* ProjectiveFitKernel::runResident(const FaceList& faces, const Positions& source,
+                                                      const Positions& target) {
+  return fit(faces, source, target, nullptr) ? &maps_ : nullptr;
+}
+
+bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, const Positions& target,
+                              compute::ProjectiveFits* out) {
+  compute::checkFitInputs(source, target);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
-  out.maps.resize(faceCount);
-  out.reciprocalScales.resize(faces.cornerCount());
-  out.residuals.resize(faceCount);
-  out.ranks.resize(faceCount);
-  if (faceCount == 0) return;
+  if (out) {
+    out->maps.resize(faceCount);
+    out->reciprocalScales.resize(faces.cornerCount());
+    out->residuals.resize(faceCount);
+    out->ranks.resize(faceCount);
+  }
+  lastMaps_.clear();
+  if (faceCount == 0) return out != nullptr;
   checkFaces(faces, static_cast<Index>(source.rows()), "fitProjectiveMaps");
 
   const std::size_t range = context_.info().maxStorageBufferRange;
   const std::size_t positionBytes = static_cast<std::size_t>(source.size()) * sizeof(double);
   checkMeshFitsOneBinding(faces, static_cast<Index>(source.rows()), range);
-  source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
-  target_.assign(context_, {target.data(), static_cast<std::size_t>(target.size())}, "target positions");
-  lastMaps_.clear();
-  offsets_.assign(context_, faces.offsets(), "face offsets");
-  indices_.assign(context_, faces.indices(), "face corners");
 
   // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
   // fit one storage binding.
   const std::vector<Index>& offset = faces.offsets();
   const std::size_t maxFaces = std::min(faceCount, range / kMapBytes);
+  std::vector<std::size_t> chunkEnds;
   std::size_t maxCorners = 0;
   for (std::size_t first = 0; first < faceCount;) {
     std::size_t last = std::min(faceCount, first + maxFaces);
     while (static_cast<std::size_t>(offset[last] - offset[first]) * sizeof(double) > range) --last;
     maxCorners = std::max<std::size_t>(maxCorners, offset[last] - offset[first]);
+    chunkEnds.push_back(last);
     first = last;
   }
+  // Fits kept on the device must all be in the maps' array at once.
+  if (!out && chunkEnds.size() > 1) return false;
+
+  source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
+  target_.assign(context_, {target.data(), static_cast<std::size_t>(target.size())}, "target positions");
+  offsets_.assign(context_, faces.offsets(), "face offsets");
+  indices_.assign(context_, faces.indices(), "face corners");
   ensureCapacity(maps_, context_, maxFaces * 16, "projective maps");
   ensureCapacity(scales_, context_, maxCorners, "reciprocal scales");
   ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
@@ -74,10 +88,8 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                      BufferRange(residuals_, 0, maxFaces * sizeof(double)),
                      BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});
   Sequence sequence(context_);
-  std::size_t chunks = 0;
-  for (std::size_t first = 0; first < faceCount; ++chunks) {
-    std::size_t last = std::min(faceCount, first + maxFaces);
-    while (static_cast<std::size_t>(offset[last] - offset[first]) * sizeof(double) > range) --last;
+  std::size_t first = 0;
+  for (const std::size_t last : chunkEnds) {
     const std::size_t n = last - first;
     sequence.begin();
     sequence.dispatch(pipeline_, set,
@@ -85,13 +97,16 @@ void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, co
                       groupsFor(context_, n, kFitGroupSize));
     sequence.end();
     sequence.run();
-    maps_.Buffer::download(out.maps.data() + first, n * kMapBytes);
-    scales_.download(std::span<double>(out.reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
-    residuals_.download(std::span<double>(out.residuals).subspan(first, n));
-    ranks_.download(std::span<std::int32_t>(out.ranks.data() + first, n));
+    if (out) {
+      maps_.Buffer::download(out->maps.data() + first, n * kMapBytes);
+      scales_.download(std::span<double>(out->reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
+      residuals_.download(std::span<double>(out->residuals).subspan(first, n));
+      ranks_.download(std::span<std::int32_t>(out->ranks.data() + first, n));
+    }
     first = last;
   }
-  if (chunks == 1) lastMaps_ = out.maps;  // maps_ holds them all
+  if (out && chunkEnds.size() == 1) lastMaps_ = out->maps;  // maps_ holds them all
+  return true;
 }
 
 const Array<double>* ProjectiveFitKernel::mapsHolding(std::span<const Eigen::Matrix4d> maps) const {

@@ -22,6 +22,11 @@ class ProjectiveFitKernel {
   /// Error(Usage) when the position arrays differ in size, Error(Device) when the
   /// positions exceed the device's storage-buffer range.
   void run(const FaceList& faces, const Positions& source, const Positions& target, compute::ProjectiveFits& out);
+  /// The same fits left on the device, nothing read back: the maps' array for the kernel
+  /// that takes them next (vk::IdealMapsKernel::runOnResidentFits), or null, with nothing
+  /// run, when the maps need more than one storage binding (then use run()). The fits of
+  /// no face count as resident (`mapsHolding` holds nothing after it).
+  const Array<double>* runResident(const FaceList& faces, const Positions& source, const Positions& target);
 
   /// The device array of the last run's maps (16 doubles a face, column-major) when it
   /// holds exactly `maps` (a run of one chunk), else null; and that of its targets when
@@ -31,6 +36,9 @@ class ProjectiveFitKernel {
   const Array<double>* targetHolding(const Positions& target) const;
 
  private:
+  /// run() with `out`, runResident() without (false: more than one chunk, nothing run).
+  bool fit(const FaceList& faces, const Positions& source, const Positions& target, compute::ProjectiveFits* out);
+
   Context& context_;
   ProjectiveFitSettings settings_;
   Pipeline pipeline_;
