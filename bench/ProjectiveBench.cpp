@@ -15,6 +15,7 @@
 #include "mesh/Generators.h"
 #include "projective/Deformation.h"
 #include "projective/GlobalStep.h"
+#include "projective/IdealMaps.h"
 #include "projective/LocalStep.h"
 #include "projective/ScaledConstraintMatrix.h"
 
@@ -55,6 +56,33 @@ void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
   for (auto _ : state) {
     auto result = plano::projective::fitFaceMaps(*backend, space, target);
     benchmark::DoNotOptimize(result.fits.maps.data());
+  }
+  setCounters(state, mesh);
+}
+
+/// How the rigid local step of a deformation runs: one fused backend call, whose fits stay
+/// where the backend computed them, or the fit and the ideal maps as two calls.
+enum class RigidLocalStep { Fused, TwoCalls };
+
+void BM_RigidLocalStep(benchmark::State& state, BackendChoice choice, RigidLocalStep how) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  plano::bench::MemoryCounters memory(state, backend);
+  const plano::PolygonMesh mesh = grid(state);
+  const plano::projective::ShapeSpace space(mesh);
+  const plano::Positions target = perspectiveTarget(space);
+  const plano::Positions normalized = space.normalization().toNormalized(target);
+  memory.markLoopStart();
+  for (auto _ : state) {
+    std::vector<Eigen::Matrix4d> ideal;
+    if (how == RigidLocalStep::Fused) {
+      ideal = plano::projective::fittedIdealMaps(*backend, space, target, plano::projective::IdealMapKind::Rigid);
+    } else {
+      const auto fit = plano::projective::fitFaceMaps(*backend, space, target);
+      ideal = plano::projective::closestIdealMaps(*backend, space, fit.fits.maps,
+                                                  plano::projective::IdealMapKind::Rigid, &normalized);
+    }
+    benchmark::DoNotOptimize(ideal.data());
   }
   setCounters(state, mesh);
 }
@@ -235,6 +263,12 @@ void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, SolverReuse reu
 BENCHMARK_CAPTURE(BM_LocalStep, cpu, BackendChoice::Cpu)
     ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LocalStep, vulkan, BackendChoice::Vulkan)
+    ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_RigidLocalStep, cpu_fused, BackendChoice::Cpu, RigidLocalStep::Fused)
+    ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_RigidLocalStep, vulkan_fused, BackendChoice::Vulkan, RigidLocalStep::Fused)
+    ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_RigidLocalStep, vulkan_two_calls, BackendChoice::Vulkan, RigidLocalStep::TwoCalls)
     ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 // On lavapipe the device global step finishes up to about 1k faces (101 s with the multigrid
 // preconditioner, the default above 64 faces); vulkan_face_blocks is the block-Jacobi baseline.
