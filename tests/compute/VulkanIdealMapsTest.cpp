@@ -11,6 +11,7 @@
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
 #include "mesh/Generators.h"
+#include "projective/GlobalStep.h"
 #include "projective/IdealMaps.h"
 #include "projective/LocalStep.h"
 #include "projective/ProjectiveTestHelpers.h"
@@ -225,6 +226,39 @@ TEST_F(VulkanIdealMaps, TheFusedLocalStepAgreesWithTheCpuAndBringsBackOnlyTheIde
   const vk::TransferCounts after = context().transfers();
   EXPECT_EQ(after.downloadedBytes - before.downloadedBytes,
             faces * (128u + 4u) + faces * (128u + 8u + 4u) + static_cast<std::uint64_t>(mesh.faces.cornerCount()) * 8u);
+}
+
+TEST_F(VulkanIdealMaps, AGlobalStepOnTheIdealMapsJustComputedFormsItsLinearTermFromThemOnTheDevice) {
+  const PolygonMesh mesh = generate::translationalSurface(6, 6);
+  const projective::ShapeSpace space(mesh);
+  std::vector<Index> fixed;
+  for (Index v = 0; v <= 6; ++v) fixed.push_back(v);
+  Positions at(fixed.size(), 3);
+  for (std::size_t i = 0; i < fixed.size(); ++i) at.row(i) = mesh.vertices.row(fixed[i]);
+  const Positions target = rotatedScaledAndPerturbed(mesh.vertices, 1.0, 0.02, 10);
+  const Positions other = rotatedScaledAndPerturbed(mesh.vertices, 1.0, 0.02, 11);
+  const auto ideal = projective::fittedIdealMaps(backend(), space, target, projective::IdealMapKind::Rigid);
+
+  // The same step twice, each with a solver of its own: first after other ideal maps were
+  // computed (q is uploaded), then right after these were (q is formed on the device).
+  const auto solveAfter = [&](const Positions& last, projective::FaceMaps& maps) {
+    projective::GlobalStep step(backend(), space, fixed);
+    const auto latest = projective::fittedIdealMaps(backend(), space, last, projective::IdealMapKind::Rigid);
+    const vk::TransferCounts before = context().transfers();
+    const projective::GlobalStepInfo info = step.solve(ideal, at, maps);
+    const vk::TransferCounts after = context().transfers();
+    EXPECT_GT(info.admmIterations, 0);
+    return std::pair{after.uploads - before.uploads, after.uploadedBytes - before.uploadedBytes};
+  };
+  projective::FaceMaps uploaded, formed;
+  const auto [uploads, uploadedBytes] = solveAfter(other, uploaded);
+  const auto [formedUploads, formedBytes] = solveAfter(target, formed);
+  const auto qBytes = static_cast<std::uint64_t>(4 * mesh.faces.size() * 3) * sizeof(double);
+  EXPECT_EQ(uploadedBytes - formedBytes, qBytes);
+  EXPECT_EQ(uploads - formedUploads, 1u);
+  // Bit for bit the same step.
+  ASSERT_EQ(formed.maps.size(), uploaded.maps.size());
+  for (std::size_t f = 0; f < formed.maps.size(); ++f) EXPECT_EQ(formed.maps[f], uploaded.maps[f]) << "face " << f;
 }
 
 TEST_F(VulkanIdealMaps, TheFusedLocalStepOfATargetOfOtherSizeIsAUsageErrorOnBothBackends) {

@@ -106,6 +106,10 @@ compute::SparseMatrix unionPatternK0(const compute::SparseMatrix& P, const compu
 struct CountPush {  // admm_scaled_values
   std::uint32_t count;
 };
+struct NegatedMapsPush {  // admm_negated_maps
+  std::uint32_t faceCount;
+  std::uint32_t columns;
+};
 struct K1AssemblePush {  // admm_k1_assemble
   std::uint32_t nonZeros;
 };
@@ -337,6 +341,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       activeSides_(context, "admm_active_sides", 5, sizeof(CountPush)),
       polishTargets_(context, "admm_polish_targets", 4, sizeof(CountPush)),
       boundViolation_(context, "admm_bound_violation", 4, sizeof(CountPush)),
+      negatedMaps_(context, "admm_negated_maps", 2, sizeof(NegatedMapsPush)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
@@ -799,7 +804,24 @@ bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
   Workspace& w = *workspace_;
   // The attempts of one global step's ε schedule solve with one q (only the bounds widen):
   // the device keeps it (nothing else writes w.q).
-  uploadIfChanged(w.q, w.uploadedQ, q);
+  if (w.uploadedQ.rows() == q.rows() && w.uploadedQ.cols() == q.cols() && w.uploadedQ == q) return true;
+  // A global step's q = -T of the ideal maps the backend's kernel just computed: formed
+  // from them where they are, bit for bit the host's.
+  const Array<double>* maps = residentMaps_ ? residentMaps_->holdingNegatedColumns(q) : nullptr;
+  if (!maps) {
+    uploadIfChanged(w.q, w.uploadedQ, q);
+    return true;
+  }
+  w.uploadedQ.resize(0, 0);  // a run that throws leaves nothing claimed
+  const auto faceCount = static_cast<std::uint32_t>(q.rows() / 4);
+  Sequence s(context_);
+  s.begin();
+  s.dispatch(negatedMaps_, {BufferRange(*maps, 0, static_cast<std::size_t>(faceCount) * 16 * sizeof(double)),
+                            BufferRange(w.q.data())},
+             NegatedMapsPush{faceCount, k}, groupsFor(context_, static_cast<std::size_t>(n_) * k));
+  s.end();
+  s.run();
+  w.uploadedQ = q;
   return true;
 }
 

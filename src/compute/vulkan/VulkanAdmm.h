@@ -47,6 +47,7 @@
 
 #include "compute/Admm.h"
 #include "compute/BlockMultigrid.h"
+#include "compute/vulkan/VulkanIdealMaps.h"
 #include "compute/vulkan/VulkanLinearAlgebra.h"
 #include "compute/vulkan/VulkanMultigrid.h"
 
@@ -102,6 +103,11 @@ class AdmmKernels final : public compute::AdmmKernels {
               const compute::AdmmSettings& settings, AdmmRecording recording = AdmmRecording::Automatic,
               std::uint32_t unitsPerDispatch = 0);
   ~AdmmKernels() override;
+
+  /// Face maps that another kernel of this context keeps on the device (the backend's ideal
+  /// maps; `maps` must outlive these kernels): start() forms a q that equals minus their
+  /// first columns there instead of uploading it.
+  void bindResidentMaps(const ResidentFaceMaps* maps) { residentMaps_ = maps; }
 
   void setRho(const std::vector<char>& equality, double rho) override;
   /// Uploads C's values (C^T's follow on the device); K1 and the multigrid's coarse K1
@@ -231,7 +237,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
-  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_;
+  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_, negatedMaps_;
+  const ResidentFaceMaps* residentMaps_ = nullptr;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.

@@ -15,7 +15,8 @@ namespace plano::compute {
 VulkanBackend::VulkanBackend(VulkanDevicePreference preference)
     : context_(std::make_unique<vk::Context>(vk::ContextSettings::fromEnvironment(
           preference == VulkanDevicePreference::RealGpuOnly ? vk::DeviceSelection::RealGpuOnly
-                                                            : vk::DeviceSelection::Any))) {}
+                                                            : vk::DeviceSelection::Any))),
+      residentMaps_(std::make_unique<vk::ResidentFaceMaps>()) {}
 
 VulkanBackend::~VulkanBackend() = default;
 
@@ -46,7 +47,7 @@ void VulkanBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, 
 void VulkanBackend::closestIdealMaps(const FaceList& faces, const Positions& source,
                                      std::span<const Eigen::Matrix4d> fitted, const Positions* target, bool similar,
                                      IdealMaps& out) {
-  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_);
+  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_, residentMaps_.get());
   // The fits of a deformation's local step come from this backend's fit kernel, whose
   // device arrays still hold them and the positions they were fitted to.
   const vk::Array<double>* residentFitted = projectiveFit_ ? projectiveFit_->mapsHolding(fitted) : nullptr;
@@ -63,7 +64,7 @@ void VulkanBackend::fitIdealMaps(const FaceList& faces, const Positions& source,
     Backend::fitIdealMaps(faces, source, target, similar, out);
     return;
   }
-  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_);
+  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_, residentMaps_.get());
   idealMaps_->runOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
 }
 
@@ -73,8 +74,10 @@ std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A,
 
 std::unique_ptr<AdmmSolver> VulkanBackend::createAdmmSolver(const SparseMatrix& P, const SparseMatrix& C,
                                                            const AdmmSettings& settings) {
-  return std::make_unique<AdmmSolver>(std::make_unique<vk::AdmmKernels>(*context_, P, C, settings), P.rows(),
-                                      C.rows(), settings);
+  auto kernels = std::make_unique<vk::AdmmKernels>(*context_, P, C, settings);
+  // A global step's targets are often the ideal maps the ideal-map kernel just computed.
+  kernels->bindResidentMaps(residentMaps_.get());
+  return std::make_unique<AdmmSolver>(std::move(kernels), P.rows(), C.rows(), settings);
 }
 
 std::unique_ptr<ReducedArapKernels> VulkanBackend::createReducedArapKernels(

@@ -11,6 +11,7 @@ class FacePlanarityKernel;
 class ProjectiveFitKernel;
 class ClosestRotationsKernel;
 class IdealMapsKernel;
+class ResidentFaceMaps;
 }  // namespace plano::vk
 
 namespace plano::compute {
@@ -63,6 +64,9 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<vk::FacePlanarityKernel> planarity_;
   std::unique_ptr<vk::ProjectiveFitKernel> projectiveFit_;
   std::unique_ptr<vk::ClosestRotationsKernel> rotations_;
+  /// The ideal maps idealMaps_ keeps on the device, for the ADMM solvers' q (declared
+  /// before the kernel, which releases it when destroyed).
+  std::unique_ptr<vk::ResidentFaceMaps> residentMaps_;
   std::unique_ptr<vk::IdealMapsKernel> idealMaps_;
 };
 

@@ -23,8 +23,21 @@ constexpr std::size_t kMapBytes = 16 * sizeof(double);
 
 }  // namespace
 
-IdealMapsKernel::IdealMapsKernel(Context& context)
-    : context_(context), pipeline_(context, "ideal_maps", 7, sizeof(Push)) {}
+const Array<double>* ResidentFaceMaps::holdingNegatedColumns(const Eigen::MatrixXd& q) const {
+  if (!array_ || q.cols() > 4 || q.rows() != 4 * static_cast<Eigen::Index>(maps_.size())) return nullptr;
+  for (std::size_t f = 0; f < maps_.size(); ++f) {
+    const auto row = static_cast<Eigen::Index>(4 * f);
+    if (q.middleRows<4>(row) != -maps_[f].leftCols(q.cols())) return nullptr;  // exact: negation rounds nothing
+  }
+  return array_;
+}
+
+IdealMapsKernel::IdealMapsKernel(Context& context, ResidentFaceMaps* resident)
+    : context_(context), resident_(resident), pipeline_(context, "ideal_maps", 7, sizeof(Push)) {}
+
+IdealMapsKernel::~IdealMapsKernel() {
+  if (resident_) resident_->release();
+}
 
 void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                           const Positions* target, bool similar, compute::IdealMaps& out,
@@ -52,6 +65,7 @@ void IdealMapsKernel::runOnResidentFits(const FaceList& faces, const Positions& 
 void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                               const Positions* target, bool similar, compute::IdealMaps& out,
                               const Array<double>* residentFitted, const Array<double>* residentTarget) {
+  if (resident_) resident_->release();  // ideal_ changes (or is reallocated) below
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   out.maps.resize(faceCount);
   out.methods.resize(faceCount);
@@ -100,6 +114,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
     ideal_.Buffer::download(out.maps.data() + first, n * kMapBytes);
     methods_.Buffer::download(out.methods.data() + first, n * sizeof(std::int32_t));
   }
+  if (resident_ && chunk == faceCount) resident_->hold(ideal_, out.maps);  // ideal_ holds them all
 }
 
 }  // namespace plano::vk

@@ -8,9 +8,39 @@
 
 namespace plano::vk {
 
+/// The face maps (16 doubles a face, column-major) that the ideal-map kernel left in its
+/// device array, with the host copy of what that array holds. The backend hands one record
+/// to that kernel, which keeps it current, and to the ADMM kernels: a global step's linear
+/// term q = -T of exactly those maps (its targets) is then formed from the array on the
+/// device instead of uploaded (vk::AdmmKernels::start).
+class ResidentFaceMaps {
+ public:
+  /// `array` holds `maps` now (until the next hold or release).
+  void hold(const Array<double>& array, std::vector<Eigen::Matrix4d> maps) {
+    array_ = &array;
+    maps_ = std::move(maps);
+  }
+  void release() {
+    array_ = nullptr;
+    maps_.clear();
+  }
+  /// The array when `q` (n x k, k <= 4) is, entry for entry, minus the first k columns of
+  /// the held maps stacked four rows a face (q(4 f + r, c) = -M_f(r, c)); else null.
+  const Array<double>* holdingNegatedColumns(const Eigen::MatrixXd& q) const;
+
+ private:
+  const Array<double>* array_ = nullptr;
+  std::vector<Eigen::Matrix4d> maps_;
+};
+
 class IdealMapsKernel {
  public:
-  explicit IdealMapsKernel(Context& context);
+  /// `resident`, when not null, is kept holding the last run's ideal maps (it must outlive
+  /// this kernel).
+  explicit IdealMapsKernel(Context& context, ResidentFaceMaps* resident = nullptr);
+  ~IdealMapsKernel();
+  IdealMapsKernel(const IdealMapsKernel&) = delete;
+  IdealMapsKernel& operator=(const IdealMapsKernel&) = delete;
 
   /// compute::Backend::closestIdealMaps. Throws Error(Usage) for #F != fitted.size() or
   /// position arrays of different sizes, Error(Device) when the positions exceed the
@@ -37,6 +67,7 @@ class IdealMapsKernel {
                const Array<double>* residentTarget);
 
   Context& context_;
+  ResidentFaceMaps* resident_;
   Pipeline pipeline_;
   // Reused across calls (grow-only): a deformation loop allocates once and uploads its
   // source and topology once.
