@@ -12,7 +12,8 @@ namespace plano::vk {
 /// device array, with the host copy of what that array holds. The backend hands one record
 /// to that kernel, which keeps it current, and to the ADMM kernels: a global step's linear
 /// term q = -T of exactly those maps (its targets) is then formed from the array on the
-/// device instead of uploaded (vk::AdmmKernels::start).
+/// device instead of uploaded (vk::AdmmKernels::start). The host copy costs 128 B a face,
+/// as the fit kernel's of its maps (exact comparison needs the values, not a digest).
 class ResidentFaceMaps {
  public:
   /// `array` holds `maps` now (until the next hold or release).
