@@ -45,19 +45,26 @@ plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
   return space.normalization().toWorld(q);
 }
 
+/// The local steps' problem: the benchmark's grid, its shape space and a projective image.
+struct LocalStepProblem {
+  explicit LocalStepProblem(benchmark::State& state)
+      : mesh(grid(state)), space(mesh), target(perspectiveTarget(space)) {}
+  plano::PolygonMesh mesh;
+  plano::projective::ShapeSpace space;
+  plano::Positions target;
+};
+
 void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
-  const plano::PolygonMesh mesh = grid(state);
-  const plano::projective::ShapeSpace space(mesh);
-  const plano::Positions target = perspectiveTarget(space);
+  const LocalStepProblem p(state);
   memory.markLoopStart();
   for (auto _ : state) {
-    auto result = plano::projective::fitFaceMaps(*backend, space, target);
+    auto result = plano::projective::fitFaceMaps(*backend, p.space, p.target);
     benchmark::DoNotOptimize(result.fits.maps.data());
   }
-  setCounters(state, mesh);
+  setCounters(state, p.mesh);
 }
 
 /// How the rigid local step of a deformation runs: one fused backend call, whose fits stay
@@ -68,23 +75,21 @@ void BM_RigidLocalStep(benchmark::State& state, BackendChoice choice, RigidLocal
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
-  const plano::PolygonMesh mesh = grid(state);
-  const plano::projective::ShapeSpace space(mesh);
-  const plano::Positions target = perspectiveTarget(space);
-  const plano::Positions normalized = space.normalization().toNormalized(target);
+  const LocalStepProblem p(state);
+  const plano::Positions normalized = p.space.normalization().toNormalized(p.target);
   memory.markLoopStart();
   for (auto _ : state) {
     std::vector<Eigen::Matrix4d> ideal;
     if (how == RigidLocalStep::Fused) {
-      ideal = plano::projective::fittedIdealMaps(*backend, space, target, plano::projective::IdealMapKind::Rigid);
+      ideal = plano::projective::fittedIdealMaps(*backend, p.space, p.target, plano::projective::IdealMapKind::Rigid);
     } else {
-      const auto fit = plano::projective::fitFaceMaps(*backend, space, target);
-      ideal = plano::projective::closestIdealMaps(*backend, space, fit.fits.maps,
+      const auto fit = plano::projective::fitFaceMaps(*backend, p.space, p.target);
+      ideal = plano::projective::closestIdealMaps(*backend, p.space, fit.fits.maps,
                                                   plano::projective::IdealMapKind::Rigid, &normalized);
     }
     benchmark::DoNotOptimize(ideal.data());
   }
-  setCounters(state, mesh);
+  setCounters(state, p.mesh);
 }
 
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:

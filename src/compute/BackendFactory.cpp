@@ -12,11 +12,19 @@ std::optional<DeviceTransfers> transfersSince(const std::optional<DeviceTransfer
                          after->downloadedBytes - before->downloadedBytes, after->copies - before->copies};
 }
 
-void checkFitInputs(const Positions& source, const Positions& target) {
+namespace {
+
+void checkSameVertexCount(const char* operation, const Positions& source, const Positions& target) {
   if (source.rows() != target.rows()) {
-    throwUsage("fitProjectiveMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
+    throwUsage(std::string(operation) + ": source has " + std::to_string(source.rows()) + " vertices, target " +
                std::to_string(target.rows()));
   }
+}
+
+}  // namespace
+
+void checkFitInputs(const Positions& source, const Positions& target) {
+  checkSameVertexCount("fitProjectiveMaps", source, target);
 }
 
 void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
@@ -25,10 +33,7 @@ void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::sp
     throwUsage("closestIdealMaps: " + std::to_string(fitted.size()) + " maps for " + std::to_string(faces.size()) +
                " faces");
   }
-  if (target && target->rows() != source.rows()) {
-    throwUsage("closestIdealMaps: source has " + std::to_string(source.rows()) + " vertices, target " +
-               std::to_string(target->rows()));
-  }
+  if (target) checkSameVertexCount("closestIdealMaps", source, *target);
 }
 
 void Backend::fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,

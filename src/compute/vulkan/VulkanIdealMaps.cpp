@@ -49,10 +49,7 @@ void IdealMapsKernel::run(const FaceList& faces, const Positions& source, std::s
 void IdealMapsKernel::runOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
                                         const Positions& target, const Array<double>* residentTarget, bool similar,
                                         compute::IdealMaps& out) {
-  if (target.rows() != source.rows()) {
-    throwUsage("closestIdealMaps: target has " + std::to_string(target.rows()) + " vertices, source " +
-               std::to_string(source.rows()));
-  }
+  compute::checkFitInputs(source, target);  // the positions the fits were made to
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   const std::size_t range = context_.info().maxStorageBufferRange;
   if (fitted.count() < faceCount * 16 || faceCount > range / kMapBytes) {
