@@ -3,8 +3,7 @@
 // planar-quad meshes from the Yas Island scale (~4k faces) to 262k faces.
 #include <benchmark/benchmark.h>
 
-#include <cmath>
-
+#include "VulkanBenchSupport.h"
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
 #include "mesh/Topology.h"
@@ -12,16 +11,8 @@
 
 namespace {
 
-plano::PolygonMesh quadMesh(std::int64_t faces) {
-  const auto side = static_cast<plano::Index>(std::lround(std::sqrt(static_cast<double>(faces))));
-  return plano::generate::translationalSurface(side, side);
-}
-
-void setCounters(benchmark::State& state, const plano::PolygonMesh& mesh) {
-  state.counters["faces"] = mesh.faceCount();
-  state.counters["faces_per_s"] =
-      benchmark::Counter(static_cast<double>(mesh.faceCount()), benchmark::Counter::kIsIterationInvariantRate);
-}
+using plano::bench::quadMesh;
+using plano::bench::setFaceCounters;
 
 void BM_Topology(benchmark::State& state) {
   const plano::PolygonMesh mesh = quadMesh(state.range(0));
@@ -29,7 +20,7 @@ void BM_Topology(benchmark::State& state) {
     plano::MeshTopology topology(mesh.faces, mesh.vertexCount());
     benchmark::DoNotOptimize(topology.edgeCount());
   }
-  setCounters(state, mesh);
+  setFaceCounters(state, mesh);
 }
 
 void BM_Validate(benchmark::State& state) {
@@ -38,7 +29,7 @@ void BM_Validate(benchmark::State& state) {
     const auto report = plano::validate(mesh);
     benchmark::DoNotOptimize(report.errorCount);
   }
-  setCounters(state, mesh);
+  setFaceCounters(state, mesh);
 }
 
 void BM_Parse(benchmark::State& state, plano::MeshFormat format, bool validate) {
@@ -50,7 +41,7 @@ void BM_Parse(benchmark::State& state, plano::MeshFormat format, bool validate) 
     const plano::PolygonMesh read = plano::parseMesh(data, format, "bench", options);
     benchmark::DoNotOptimize(read.vertices.data());
   }
-  setCounters(state, mesh);
+  setFaceCounters(state, mesh);
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(data.size()));
 }
 
@@ -60,7 +51,7 @@ void BM_Format(benchmark::State& state, plano::MeshFormat format) {
     const std::string data = plano::formatMesh(mesh, format);
     benchmark::DoNotOptimize(data.data());
   }
-  setCounters(state, mesh);
+  setFaceCounters(state, mesh);
 }
 
 #define PLANO_MESH_SIZES ->Arg(4096)->Arg(65536)->Arg(262144)->Unit(benchmark::kMillisecond)

@@ -29,10 +29,6 @@ plano::PolygonMesh grid(benchmark::State& state) {
   return plano::generate::translationalSurface(side, side);
 }
 
-void setCounters(benchmark::State& state, const plano::PolygonMesh& mesh) {
-  state.counters["faces"] = mesh.faceCount();
-}
-
 /// A projective image of the grid: every face has a nontrivial exact fit.
 plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
   Eigen::Matrix4d H;
@@ -64,7 +60,7 @@ void BM_LocalStep(benchmark::State& state, BackendChoice choice) {
     auto result = plano::projective::fitFaceMaps(*backend, p.space, p.target);
     benchmark::DoNotOptimize(result.fits.maps.data());
   }
-  setCounters(state, p.mesh);
+  plano::bench::setFaceCounters(state, p.mesh);
 }
 
 /// How the rigid local step of a deformation runs: one fused backend call, whose fits stay
@@ -89,7 +85,7 @@ void BM_RigidLocalStep(benchmark::State& state, BackendChoice choice, RigidLocal
     }
     benchmark::DoNotOptimize(ideal.data());
   }
-  setCounters(state, p.mesh);
+  plano::bench::setFaceCounters(state, p.mesh);
 }
 
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:
@@ -120,7 +116,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
     info = global.solve(targets, at, result);
     benchmark::DoNotOptimize(result.maps.data());
   }
-  setCounters(state, mesh);
+  plano::bench::setFaceCounters(state, mesh);
   state.counters["admm_iterations"] = info.admmIterations;
   state.counters["factorizations"] = info.factorizations;
   state.counters["linear_iterations"] = static_cast<double>(info.linearIterations);
@@ -151,7 +147,7 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
     admm = info.history.empty() ? 0 : info.history.back().admmIterations;
     benchmark::DoNotOptimize(positions.data());
   }
-  setCounters(state, mesh);
+  plano::bench::setFaceCounters(state, mesh);
   state.counters["admm_iterations"] = admm;
 }
 
@@ -221,7 +217,7 @@ void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
       benchmark::DoNotOptimize(C.valuePtr());
     }
   }
-  setCounters(state, mesh);
+  plano::bench::setFaceCounters(state, mesh);
 }
 
 /// What a projective global step pays before its first ADMM iteration, with a new ADMM
@@ -262,7 +258,7 @@ void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, SolverReuse reu
     solver->solve(q, bounds, bounds, x, y, z);
     benchmark::DoNotOptimize(x.data());
   }
-  setCounters(state, mesh);
+  plano::bench::setFaceCounters(state, mesh);
 }
 
 BENCHMARK_CAPTURE(BM_LocalStep, cpu, BackendChoice::Cpu)

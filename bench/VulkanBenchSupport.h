@@ -105,6 +105,12 @@ inline void setThroughput(benchmark::State& state, double items, const char* nam
   state.counters[name] = benchmark::Counter(items, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+/// The mesh's face count, and faces per second as a rate counter.
+inline void setFaceCounters(benchmark::State& state, const PolygonMesh& mesh) {
+  state.counters["faces"] = static_cast<double>(mesh.faceCount());
+  setThroughput(state, static_cast<double>(mesh.faceCount()));
+}
+
 /// The standard sizes; the two large ones run once (lavapipe is a CPU JIT: slow).
 inline void standardSizes(benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -32,4 +32,8 @@ double boundingBoxDiagonal(const Positions& vertices) {
   return (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
 }
 
+double maxVertexDistance(const Positions& before, const Positions& after) {
+  return before.rows() == 0 ? 0.0 : (after - before).rowwise().norm().maxCoeff();
+}
+
 }  // namespace plano

@@ -57,4 +57,8 @@ struct PolygonMesh {
 /// Length of the bounding-box diagonal (0 for an empty mesh).
 double boundingBoxDiagonal(const Positions& vertices);
 
+/// The largest distance a vertex moved from `before` to `after` (same #V; 0 for none): the
+/// local/global loops' displacement stopping test.
+double maxVertexDistance(const Positions& before, const Positions& after);
+
 }  // namespace plano

@@ -1,16 +1,14 @@
 #include "planarize/AndersonPlanarizer.h"
 
 #include <Eigen/Dense>
-#include <chrono>
 
+#include "core/Timing.h"
 #include "planarize/Monitor.h"
 #include "planarize/Problem.h"
 #include "planarize/ShapeUpStep.h"
 
 namespace plano::planarize {
 namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 using FlatView = Eigen::Map<Eigen::VectorXd>;
 using ConstFlatView = Eigen::Map<const Eigen::VectorXd>;
 }  // namespace
@@ -18,7 +16,7 @@ using ConstFlatView = Eigen::Map<const Eigen::VectorXd>;
 AndersonPlanarizer::AndersonPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
                                        compute::Backend& backend)
     : settings_(settings), backend_(&backend) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
   step_ = std::make_unique<detail::ShapeUpStep>(*problem_, settings.closeness, backend);
   precomputeSeconds_ = secondsSince(start);
@@ -27,7 +25,7 @@ AndersonPlanarizer::AndersonPlanarizer(const FaceList& faces, const Positions& i
 AndersonPlanarizer::~AndersonPlanarizer() = default;
 
 Info AndersonPlanarizer::solve(Positions& vertices) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
   Positions Y = detail::toNormalized(problem, vertices);
   for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {

@@ -3,11 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <memory>
 
 #include "core/Error.h"
+#include "core/Timing.h"
 #include "mesh/Planarity.h"
 #include "planarize/Monitor.h"
 #include "planarize/Problem.h"
@@ -34,12 +34,6 @@ struct GaussNewtonWorkspace {
 };
 
 namespace {
-
-int findSlot(const compute::SparseMatrix& m, int row, int col) {
-  const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[row];
-  const int* end = m.innerIndexPtr() + m.outerIndexPtr()[row + 1];
-  return static_cast<int>(std::lower_bound(begin, end, col) - m.innerIndexPtr());
-}
 
 void buildRows(const Problem& problem, GaussNewtonWorkspace& ws) {
   const FaceList& faces = *problem.faces;
@@ -77,13 +71,13 @@ void buildRows(const Problem& problem, GaussNewtonWorkspace& ws) {
   ws.system.setFromTriplets(triplets.begin(), triplets.end());
   ws.system.makeCompressed();
   ws.diagonalSlots.resize(static_cast<std::size_t>(n));
-  for (Index j = 0; j < n; ++j) ws.diagonalSlots[j] = findSlot(ws.system, j, j);
+  for (Index j = 0; j < n; ++j) ws.diagonalSlots[j] = storedEntrySlot(ws.system, j, j);
   ws.pairSlotOffset.assign(static_cast<std::size_t>(vertexCount) + 1, 0);
   for (Index v = 0; v < vertexCount; ++v) {
     ws.pairSlotOffset[v] = static_cast<int>(ws.pairSlots.size());
     for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p)
       for (int q = ws.incidenceOffset[v]; q < ws.incidenceOffset[v + 1]; ++q)
-        ws.pairSlots.push_back(findSlot(ws.system, ws.incidences[p].first, ws.incidences[q].first));
+        ws.pairSlots.push_back(storedEntrySlot(ws.system, ws.incidences[p].first, ws.incidences[q].first));
   }
   ws.pairSlotOffset[vertexCount] = static_cast<int>(ws.pairSlots.size());
   ws.jacobian.resize(ws.rows.size());
@@ -198,15 +192,10 @@ void correctorStep(const Problem& problem, const std::vector<Eigen::Matrix<doubl
 }  // namespace
 }  // namespace detail
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-}  // namespace
-
 GaussNewtonPlanarizer::GaussNewtonPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
                                              compute::Backend& backend)
     : settings_(settings), backend_(&backend) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
   workspace_ = std::make_unique<detail::GaussNewtonWorkspace>();
   detail::buildRows(*problem_, *workspace_);
@@ -216,7 +205,7 @@ GaussNewtonPlanarizer::GaussNewtonPlanarizer(const FaceList& faces, const Positi
 GaussNewtonPlanarizer::~GaussNewtonPlanarizer() = default;
 
 Info GaussNewtonPlanarizer::solve(Positions& vertices) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
   detail::GaussNewtonWorkspace& ws = *workspace_;
   Positions Y = detail::toNormalized(problem, vertices);

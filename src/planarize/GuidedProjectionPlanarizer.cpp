@@ -2,10 +2,10 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "core/Error.h"
+#include "core/Timing.h"
 #include "planarize/Monitor.h"
 #include "planarize/Problem.h"
 
@@ -27,12 +27,6 @@ struct GuidedProjectionWorkspace {
 };
 
 namespace {
-
-int findSlot(const compute::SparseMatrix& m, int row, int col) {
-  const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[row];
-  const int* end = m.innerIndexPtr() + m.outerIndexPtr()[row + 1];
-  return static_cast<int>(std::lower_bound(begin, end, col) - m.innerIndexPtr());
-}
 
 void buildPattern(const Problem& problem, GuidedProjectionWorkspace& ws) {
   const FaceList& faces = *problem.faces;
@@ -58,7 +52,7 @@ void buildPattern(const Problem& problem, GuidedProjectionWorkspace& ws) {
   ws.system.setFromTriplets(triplets.begin(), triplets.end());
   ws.system.makeCompressed();
   ws.diagonalSlots.resize(static_cast<std::size_t>(n));
-  for (Index row = 0; row < n; ++row) ws.diagonalSlots[row] = findSlot(ws.system, row, row);
+  for (Index row = 0; row < n; ++row) ws.diagonalSlots[row] = storedEntrySlot(ws.system, row, row);
   ws.faceSlotOffset.resize(problem.constrainedFaces.size());
   ws.faceSlots.clear();
   ws.faceSlots.reserve(total);
@@ -71,7 +65,7 @@ void buildPattern(const Problem& problem, GuidedProjectionWorkspace& ws) {
         const Index fj = problem.freeIndex[j];
         for (int r = 0; r < 3; ++r)
           for (int col = 0; col < 3; ++col)
-            ws.faceSlots.push_back(fi < 0 || fj < 0 ? -1 : findSlot(ws.system, 3 * fi + r, 3 * fj + col));
+            ws.faceSlots.push_back(fi < 0 || fj < 0 ? -1 : storedEntrySlot(ws.system, 3 * fi + r, 3 * fj + col));
       }
     }
   }
@@ -204,15 +198,10 @@ void updatePlanes(const Problem& problem, const Positions& oldY, const Positions
 }  // namespace
 }  // namespace detail
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-}  // namespace
-
 GuidedProjectionPlanarizer::GuidedProjectionPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
                                              compute::Backend& backend)
     : settings_(settings), backend_(&backend) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
   workspace_ = std::make_unique<detail::GuidedProjectionWorkspace>();
   detail::buildPattern(*problem_, *workspace_);
@@ -222,7 +211,7 @@ GuidedProjectionPlanarizer::GuidedProjectionPlanarizer(const FaceList& faces, co
 GuidedProjectionPlanarizer::~GuidedProjectionPlanarizer() = default;
 
 Info GuidedProjectionPlanarizer::solve(Positions& vertices) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
   detail::GuidedProjectionWorkspace& ws = *workspace_;
   Positions Y = detail::toNormalized(problem, vertices);

@@ -1,21 +1,16 @@
 #include "planarize/ShapeUpPlanarizer.h"
 
-#include <chrono>
-
+#include "core/Timing.h"
 #include "planarize/Monitor.h"
 #include "planarize/Problem.h"
 #include "planarize/ShapeUpStep.h"
 
 namespace plano::planarize {
-namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-}  // namespace
 
 ShapeUpPlanarizer::ShapeUpPlanarizer(const FaceList& faces, const Positions& input, const Settings& settings,
                                      compute::Backend& backend)
     : settings_(settings), backend_(&backend) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   problem_ = std::make_unique<detail::Problem>(detail::makeProblem(faces, input, settings));
   step_ = std::make_unique<detail::ShapeUpStep>(*problem_, settings.closeness, backend);
   precomputeSeconds_ = secondsSince(start);
@@ -24,7 +19,7 @@ ShapeUpPlanarizer::ShapeUpPlanarizer(const FaceList& faces, const Positions& inp
 ShapeUpPlanarizer::~ShapeUpPlanarizer() = default;
 
 Info ShapeUpPlanarizer::solve(Positions& vertices) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
   Positions Y = detail::toNormalized(problem, vertices);
   for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {

@@ -8,13 +8,6 @@
 #include "projective/LocalStep.h"
 
 namespace plano::projective {
-namespace {
-
-double maxRowDistance(const Positions& a, const Positions& b) {
-  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
-}
-
-}  // namespace
 
 const char* toString(DeformationStatus status) {
   switch (status) {
@@ -64,7 +57,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     it.admmIterations = step.admmIterations;
     it.linearIterations = step.linearIterations;
     it.attempts = step.attempts;
-    it.displacement = maxRowDistance(next, positions) / diagonal;
+    it.displacement = maxVertexDistance(next, positions) / diagonal;
     it.maxPlanarity = planarityStats(PolygonMesh{next, space_.faces()}).max;
     info.history.push_back(it);
     if (callback) callback(it);

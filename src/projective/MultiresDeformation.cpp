@@ -1,25 +1,18 @@
 #include "projective/MultiresDeformation.h"
 
-#include <chrono>
 #include <string>
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "core/Timing.h"
 #include "projective/Deformation.h"
 #include "projective/LocalStep.h"
 #include "projective/MultiresCoarseStep.h"
 #include "projective/ShapeSpace.h"
 
 namespace plano::projective {
+
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-double maxRowDistance(const Positions& a, const Positions& b) {
-  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
-}
 
 /// (x, 1) M = ((x - centre) / scale, 1): world to normalized coordinates as a 4x4 map in
 /// the row-vector convention, and its inverse.
@@ -101,7 +94,7 @@ void deformFinest(compute::Backend& backend, const PolygonMesh& mesh, const Posi
   direct.maxProjectionIterations = settings.maxProjectionIterations;
   direct.global = settings.global;
   direct.global.smoothness = 0.0;
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const DeformationResult deformed = deform(backend, mesh, constraints, direct);
   if (deformed.info.status == DeformationStatus::NumericalFailure) throwNumerical("multires: " + deformed.info.message);
   result.positions = deformed.mesh.vertices;
@@ -128,7 +121,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
                               const std::vector<Positions>& positions, const PositionalConstraints& constraints,
                               const MultiresSettings& settings) {
   checkInput(hierarchy, positions, settings);
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const int finest = hierarchy.finestLevel();
   MultiresResult result;
   MultiresInfo& info = result.info;
@@ -147,7 +140,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     deformFinest(backend, fineMesh, constraints, settings, result);
   } else {
     // Coarse deformation (§6.1 on M_k with the coarsened constraints of §6.2).
-    const auto coarseStart = Clock::now();
+    const auto coarseStart = SteadyClock::now();
     const CoarseConstraints coarse = coarsenConstraints(hierarchy, positions[finest], constraints, level);
     const ShapeSpace coarseSpace(PolygonMesh{positions[level], hierarchy.faces(level)});
     GlobalStepSettings coarseSettings = settings.global;
@@ -162,7 +155,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
       const auto ideal = fittedIdealMaps(backend, coarseSpace, current, settings.energy);
       const GlobalStepInfo step = coarseStep.solve(ideal, coarseMaps);
       const Positions next = coarseSpace.positions(coarseMaps.maps);
-      const double displacement = maxRowDistance(next, current) / coarseDiagonal;
+      const double displacement = maxVertexDistance(next, current) / coarseDiagonal;
       info.coarseEpsilons.push_back(step.epsilon);
       info.coarseDisplacements.push_back(displacement);
       ++info.coarseIterations;
@@ -173,7 +166,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     info.coarseSeconds = secondsSince(coarseStart);
 
     // Prolongation (§6.3) and the fine global step with the user's constraints.
-    const auto fineStart = Clock::now();
+    const auto fineStart = SteadyClock::now();
     const ShapeSpace fineSpace(fineMesh);
     const auto prolonged = prolongMaps(coarseMaps.maps, coarseSpace.normalization(), fineSpace.normalization(),
                                        hierarchy.ancestorsOfFinestFaces(level));

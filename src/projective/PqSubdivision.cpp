@@ -1,23 +1,16 @@
 #include "projective/PqSubdivision.h"
 
-#include <chrono>
 #include <string>
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "core/Timing.h"
 #include "projective/LocalStep.h"
 #include "projective/ShapeSpace.h"
 
 namespace plano::projective {
+
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-double maxRowDistance(const Positions& a, const Positions& b) {
-  return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
-}
 
 PlanarityStats planarityOf(compute::Backend& backend, const PolygonMesh& mesh, double tolerance) {
   std::vector<double> values(mesh.faceCount());
@@ -58,7 +51,7 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.linearIterations = step.linearIterations;
     record.attempts = step.attempts;
     record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
-    record.maxChange = diagonal > 0.0 ? maxRowDistance(current.vertices, previous) / diagonal : 0.0;
+    record.maxChange = diagonal > 0.0 ? maxVertexDistance(current.vertices, previous) / diagonal : 0.0;
     record.transfers = compute::transfersSince(transfersBefore, backend.transfers());
     info.iterations.push_back(record);
     if (callback) callback(info.level, iteration + 1, info.iterations.back());
@@ -86,13 +79,13 @@ const char* toString(PqSubdivisionStatus status) {
 PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
                                          const PqSubdivisionSettings& settings, const PqIterationCallback& callback) {
   checkSettings(settings);
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   PqSubdivisionResult result{SubdivisionHierarchy(base.faces, base.vertexCount(), settings.levels), {base.vertices}, {}};
   PqSubdivisionInfo& info = result.info;
   info.status = settings.planarize ? PqSubdivisionStatus::Converged : PqSubdivisionStatus::LinearOnly;
 
   for (int level = 1; level <= settings.levels; ++level) {
-    const auto levelStart = Clock::now();
+    const auto levelStart = SteadyClock::now();
     const QuadRefinement& refinement = result.hierarchy.refinement(level);
     const FaceList& coarseFaces = result.hierarchy.faces(level - 1);
     const Positions& coarse = result.positions.back();
@@ -112,7 +105,7 @@ PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const Polygo
       if (!levelInfo.converged) info.status = PqSubdivisionStatus::IterationLimit;
     }
     const double diagonal = boundingBoxDiagonal(linear);
-    levelInfo.distanceToLinear = diagonal > 0.0 ? maxRowDistance(fine, linear) / diagonal : 0.0;
+    levelInfo.distanceToLinear = diagonal > 0.0 ? maxVertexDistance(fine, linear) / diagonal : 0.0;
     levelInfo.planarity = planarityOf(backend, PolygonMesh{fine, refinement.fineFaces}, settings.planarityTolerance);
     levelInfo.seconds = secondsSince(levelStart);
     info.totalIterations += static_cast<int>(levelInfo.iterations.size());

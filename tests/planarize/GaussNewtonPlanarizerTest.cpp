@@ -12,28 +12,23 @@
 namespace plano::planarize {
 namespace {
 
-Info run(const PolygonMesh& mesh, Positions& result, const Settings& settings) {
+Info runGaussNewton(const PolygonMesh& mesh, Positions& result, const Settings& settings) {
   compute::CpuBackend backend;
   result = mesh.vertices;
   return GaussNewtonPlanarizer(mesh.faces, mesh.vertices, settings, backend).solve(result);
-}
-
-/// Max planarity measured independently of the solver's own bookkeeping.
-double maxPlanarity(const FaceList& faces, const Positions& vertices) {
-  return planarityStats(PolygonMesh{vertices, faces}).max;
 }
 
 TEST(GaussNewtonPlanarizer, PlanarizesHyparGridWithinThirtyIterations) {
   const PolygonMesh mesh = generate::hyparGrid(8, 0.5);
   ASSERT_GT(planarityStats(mesh).max, 1.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGaussNewton(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
   EXPECT_LE(info.iterations, 30);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
   // The solver measures its normalized copy, the check the result in the caller's units:
   // equal up to the rounding of the normalization.
-  const double measured = maxPlanarity(mesh.faces, result);
+  const double measured = test::maxPlanarity(mesh.faces, result);
   EXPECT_NEAR(info.maxPlanarity.back(), measured, 1e-12 * measured);
   EXPECT_EQ(info.maxPlanarity.size(), static_cast<std::size_t>(info.iterations) + 1);
 }
@@ -43,10 +38,10 @@ TEST(GaussNewtonPlanarizer, PlanarizesPerturbedTranslationalSurface) {
   mesh.vertices = test::perturbed(mesh.vertices, 0.01);
   ASSERT_GT(planarityStats(mesh).max, 2.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGaussNewton(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
   EXPECT_LE(info.iterations, 30);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
   // Noise of 1 % of the grid spacing needs only small corrections.
   EXPECT_LT(info.maxDisplacement, 0.02);
   EXPECT_GT(info.meanDisplacement, 0.0);
@@ -56,9 +51,9 @@ TEST(GaussNewtonPlanarizer, PlanarizesMixedDegreeMeshAndIgnoresTriangles) {
   const PolygonMesh mesh = test::mixedDegreeHyparPatch();
   ASSERT_GT(planarityStats(mesh).max, 1.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGaussNewton(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
   for (Index f = 0; f < mesh.faceCount(); ++f) {
     EXPECT_LE(facePlanarity(result, mesh.faces[f]).mean, 0.1) << "face " << f;
   }
@@ -69,9 +64,9 @@ TEST(GaussNewtonPlanarizer, PlanarizesClosedMesh) {
   mesh.vertices = test::perturbed(mesh.vertices, 0.05);
   ASSERT_GT(planarityStats(mesh).max, 1.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGaussNewton(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
 }
 
 TEST(GaussNewtonPlanarizer, FixedVerticesStayExactlyFixed) {
@@ -80,10 +75,10 @@ TEST(GaussNewtonPlanarizer, FixedVerticesStayExactlyFixed) {
   // Vertices of the first grid row, one of the second and one in the far corner.
   settings.fixed = {0, 1, 2, 3, 6, 48};
   Positions result;
-  const Info info = run(mesh, result, settings);
+  const Info info = runGaussNewton(mesh, result, settings);
   EXPECT_EQ(info.status, Status::Converged);
   for (Index v : settings.fixed) EXPECT_EQ(result.row(v), mesh.vertices.row(v)) << "vertex " << v;
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
 }
 
 TEST(GaussNewtonPlanarizer, LargerClosenessMovesTheMeshLessAndStillReachesTheTolerance) {
@@ -95,9 +90,9 @@ TEST(GaussNewtonPlanarizer, LargerClosenessMovesTheMeshLessAndStillReachesTheTol
   for (const double closeness : {0.0, 1e-5, 1e-3}) {
     settings.closeness = closeness;
     Positions result;
-    const Info info = run(mesh, result, settings);
+    const Info info = runGaussNewton(mesh, result, settings);
     EXPECT_EQ(info.status, Status::Converged) << "closeness " << closeness;
-    EXPECT_LE(maxPlanarity(mesh.faces, result), 0.01) << "closeness " << closeness;
+    EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.01) << "closeness " << closeness;
     EXPECT_LT(info.meanDisplacement, previousDisplacement) << "closeness " << closeness;
     previousDisplacement = info.meanDisplacement;
   }
@@ -108,8 +103,8 @@ TEST(GaussNewtonPlanarizer, ResultScalesWithTheInput) {
   PolygonMesh scaled = mesh;
   scaled.vertices *= 1e4;
   Positions a, b;
-  const Info infoA = run(mesh, a, Settings{});
-  const Info infoB = run(scaled, b, Settings{});
+  const Info infoA = runGaussNewton(mesh, a, Settings{});
+  const Info infoB = runGaussNewton(scaled, b, Settings{});
   EXPECT_EQ(infoA.iterations, infoB.iterations);
   EXPECT_LT(test::maxAbsDifference(a * 1e4, b), 1e-6 * 1e4);
   EXPECT_NEAR(infoA.maxDisplacement, infoB.maxDisplacement, 1e-9);
@@ -118,7 +113,7 @@ TEST(GaussNewtonPlanarizer, ResultScalesWithTheInput) {
 TEST(GaussNewtonPlanarizer, AlreadyPlanarMeshIsReturnedUnchangedWithoutIterations) {
   const PolygonMesh mesh = generate::surfaceOfRevolution(12, 6);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGaussNewton(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
   EXPECT_EQ(info.iterations, 0);
   EXPECT_LT(test::maxAbsDifference(result, mesh.vertices), 1e-12);

@@ -11,28 +11,23 @@
 namespace plano::planarize {
 namespace {
 
-Info run(const PolygonMesh& mesh, Positions& result, const Settings& settings) {
+Info runGuidedProjection(const PolygonMesh& mesh, Positions& result, const Settings& settings) {
   compute::CpuBackend backend;
   result = mesh.vertices;
   return GuidedProjectionPlanarizer(mesh.faces, mesh.vertices, settings, backend).solve(result);
-}
-
-/// Max planarity measured independently of the solver's own bookkeeping.
-double maxPlanarity(const FaceList& faces, const Positions& vertices) {
-  return planarityStats(PolygonMesh{vertices, faces}).max;
 }
 
 TEST(GuidedProjectionPlanarizer, PlanarizesHyparGridWithinThirtyIterations) {
   const PolygonMesh mesh = generate::hyparGrid(8, 0.5);
   ASSERT_GT(planarityStats(mesh).max, 1.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGuidedProjection(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
   EXPECT_LE(info.iterations, 30);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
   // The solver measures its normalized copy, the check the result in the caller's units:
   // equal up to the rounding of the normalization.
-  const double measured = maxPlanarity(mesh.faces, result);
+  const double measured = test::maxPlanarity(mesh.faces, result);
   EXPECT_NEAR(info.maxPlanarity.back(), measured, 1e-12 * measured);
   EXPECT_EQ(info.maxPlanarity.size(), static_cast<std::size_t>(info.iterations) + 1);
 }
@@ -41,9 +36,9 @@ TEST(GuidedProjectionPlanarizer, PlanarizesMixedDegreeMeshAndIgnoresTriangles) {
   const PolygonMesh mesh = test::mixedDegreeHyparPatch();
   ASSERT_GT(planarityStats(mesh).max, 1.0);
   Positions result;
-  const Info info = run(mesh, result, Settings{});
+  const Info info = runGuidedProjection(mesh, result, Settings{});
   EXPECT_EQ(info.status, Status::Converged);
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
   for (Index f = 0; f < mesh.faceCount(); ++f) {
     EXPECT_LE(facePlanarity(result, mesh.faces[f]).mean, 0.1) << "face " << f;
   }
@@ -55,10 +50,10 @@ TEST(GuidedProjectionPlanarizer, FixedVerticesStayExactlyFixed) {
   // Vertices of the first grid row, one of the second and one in the far corner.
   settings.fixed = {0, 1, 2, 3, 6, 48};
   Positions result;
-  const Info info = run(mesh, result, settings);
+  const Info info = runGuidedProjection(mesh, result, settings);
   EXPECT_EQ(info.status, Status::Converged);
   for (Index v : settings.fixed) EXPECT_EQ(result.row(v), mesh.vertices.row(v)) << "vertex " << v;
-  EXPECT_LE(maxPlanarity(mesh.faces, result), 0.1);
+  EXPECT_LE(test::maxPlanarity(mesh.faces, result), 0.1);
 }
 
 TEST(GuidedProjectionPlanarizer, LargerClosenessMovesTheMeshLessAndLeavesItLessPlanar) {
@@ -72,8 +67,8 @@ TEST(GuidedProjectionPlanarizer, LargerClosenessMovesTheMeshLessAndLeavesItLessP
   for (const double closeness : {1e-5, 1e-3, 1e-1, 10.0}) {
     settings.closeness = closeness;
     Positions result;
-    const Info info = run(mesh, result, settings);
-    const double planarity = maxPlanarity(mesh.faces, result);
+    const Info info = runGuidedProjection(mesh, result, settings);
+    const double planarity = test::maxPlanarity(mesh.faces, result);
     EXPECT_LT(info.meanDisplacement, previousDisplacement) << "closeness " << closeness;
     EXPECT_GT(planarity, previousPlanarity) << "closeness " << closeness;
     previousDisplacement = info.meanDisplacement;

@@ -1,5 +1,7 @@
 #include "planarize/PlanarizeTestMeshes.h"
 
+#include "mesh/Planarity.h"
+
 namespace plano::test {
 
 PolygonMesh mixedDegreeHyparPatch() {
@@ -24,6 +26,10 @@ PolygonMesh mixedDegreeHyparPatch() {
     for (Index i = 0; i < n; ++i) mesh.faces.addFace({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
   }
   return mesh;
+}
+
+double maxPlanarity(const FaceList& faces, const Positions& vertices) {
+  return planarityStats(PolygonMesh{vertices, faces}).max;
 }
 
 }  // namespace plano::test

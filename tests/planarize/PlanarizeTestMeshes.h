@@ -8,4 +8,8 @@ namespace plano::test {
 /// whose second row is merged pairwise into hexagons; the other rows are quads. Open.
 PolygonMesh mixedDegreeHyparPatch();
 
+/// Max planarity of the faces at `vertices`, measured independently of a solver's own
+/// bookkeeping.
+double maxPlanarity(const FaceList& faces, const Positions& vertices);
+
 }  // namespace plano::test

@@ -8,7 +8,7 @@
 namespace plano::vk {
 namespace {
 
-struct Push {
+struct ClosestRotationsPush {
   std::uint32_t count;
 };
 
@@ -18,7 +18,7 @@ static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "Vector3d must be 3
 }  // namespace
 
 ClosestRotationsKernel::ClosestRotationsKernel(Context& context)
-    : context_(context), pipeline_(context, "closest_rotations", 3, sizeof(Push)) {}
+    : context_(context), pipeline_(context, "closest_rotations", 3, sizeof(ClosestRotationsPush)) {}
 
 void ClosestRotationsKernel::run(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                                  std::span<Eigen::Vector3d> singularValues) {
@@ -41,7 +41,7 @@ void ClosestRotationsKernel::run(std::span<const Eigen::Matrix3d> matrices, std:
     const std::size_t n = std::min(chunk, count - first);
     input_.Buffer::upload(matrices.data() + first, n * matrixBytes);
     sequence.begin();
-    sequence.dispatch(pipeline_, set, Push{static_cast<std::uint32_t>(n)}, groupsFor(context_, n));
+    sequence.dispatch(pipeline_, set, ClosestRotationsPush{static_cast<std::uint32_t>(n)}, groupsFor(context_, n));
     sequence.end();
     sequence.run();
     output_.Buffer::download(rotations.data() + first, n * matrixBytes);

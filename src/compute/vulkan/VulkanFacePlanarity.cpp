@@ -9,7 +9,7 @@
 namespace plano::vk {
 namespace {
 
-struct Push {
+struct FacePlanarityPush {
   std::uint32_t firstFace;
   std::uint32_t faceCount;
 };
@@ -17,7 +17,7 @@ struct Push {
 }  // namespace
 
 FacePlanarityKernel::FacePlanarityKernel(Context& context)
-    : context_(context), pipeline_(context, "face_planarity", 4, sizeof(Push)) {}
+    : context_(context), pipeline_(context, "face_planarity", 4, sizeof(FacePlanarityPush)) {}
 
 void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
   const std::size_t faceCount = static_cast<std::size_t>(mesh.faceCount());
@@ -51,7 +51,7 @@ void FacePlanarityKernel::run(const PolygonMesh& mesh, std::span<double> out) {
   for (std::size_t first = 0; first < faceCount; first += chunk) {
     const std::size_t count = std::min(chunk, faceCount - first);
     sequence.begin();
-    sequence.dispatch(pipeline_, set, Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(count)},
+    sequence.dispatch(pipeline_, set, FacePlanarityPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(count)},
                       groupsFor(context_, count));
     sequence.end();
     sequence.run();

@@ -9,7 +9,7 @@
 namespace plano::vk {
 namespace {
 
-struct Push {
+struct IdealMapsPush {
   std::uint32_t firstFace;
   std::uint32_t faceCount;
   std::uint32_t hasTarget;
@@ -33,7 +33,7 @@ const Array<double>* ResidentFaceMaps::holdingNegatedColumns(const Eigen::Matrix
 }
 
 IdealMapsKernel::IdealMapsKernel(Context& context, ResidentFaceMaps* resident)
-    : context_(context), resident_(resident), pipeline_(context, "ideal_maps", 7, sizeof(Push)) {}
+    : context_(context), resident_(resident), pipeline_(context, "ideal_maps", 7, sizeof(IdealMapsPush)) {}
 
 IdealMapsKernel::~IdealMapsKernel() {
   if (resident_) resident_->release();
@@ -103,7 +103,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
     if (!residentFitted) fitted_.Buffer::upload(fitted.data() + first, n * kMapBytes);
     sequence.begin();
     sequence.dispatch(pipeline_, set,
-                      Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), target ? 1u : 0u,
+                      IdealMapsPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), target ? 1u : 0u,
                            similar ? 1u : 0u},
                       groupsFor(context_, n));
     sequence.end();

@@ -9,7 +9,7 @@
 namespace plano::vk {
 namespace {
 
-struct Push {
+struct ProjectiveFitPush {
   std::uint32_t firstFace;
   std::uint32_t faceCount;
   double rankThreshold;
@@ -26,7 +26,7 @@ constexpr std::uint32_t kFitGroupSize = 64;
 }  // namespace
 
 ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings settings)
-    : context_(context), settings_(settings), pipeline_(context, "projective_fit", 8, sizeof(Push)) {}
+    : context_(context), settings_(settings), pipeline_(context, "projective_fit", 8, sizeof(ProjectiveFitPush)) {}
 
 void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
                               compute::ProjectiveFits& out) {
@@ -93,7 +93,7 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
     const std::size_t n = last - first;
     sequence.begin();
     sequence.dispatch(pipeline_, set,
-                      Push{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), settings_.rankThreshold},
+                      ProjectiveFitPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), settings_.rankThreshold},
                       groupsFor(context_, n, kFitGroupSize));
     sequence.end();
     sequence.run();
