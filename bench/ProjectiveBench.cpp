@@ -24,11 +24,6 @@ namespace {
 using plano::Index;
 using plano::compute::BackendChoice;
 
-plano::PolygonMesh grid(benchmark::State& state) {
-  const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(state.range(0)))));
-  return plano::generate::translationalSurface(side, side);
-}
-
 /// A projective image of the grid: every face has a nontrivial exact fit.
 plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
   Eigen::Matrix4d H;
@@ -44,7 +39,7 @@ plano::Positions perspectiveTarget(const plano::projective::ShapeSpace& space) {
 /// The local steps' problem: the benchmark's grid, its shape space and a projective image.
 struct LocalStepProblem {
   explicit LocalStepProblem(benchmark::State& state)
-      : mesh(grid(state)), space(mesh), target(perspectiveTarget(space)) {}
+      : mesh(plano::bench::quadMesh(state.range(0))), space(mesh), target(perspectiveTarget(space)) {}
   plano::PolygonMesh mesh;
   plano::projective::ShapeSpace space;
   plano::Positions target;
@@ -95,7 +90,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
-  const plano::PolygonMesh mesh = grid(state);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::projective::ShapeSpace space(mesh);
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
   std::vector<Index> fixed;
@@ -127,7 +122,7 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
-  const plano::PolygonMesh mesh = grid(state);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const auto side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
   plano::PositionalConstraints constraints;
   for (Index i = 0; i <= side; ++i) constraints.fixed.push_back(i * (side + 1));
@@ -204,7 +199,7 @@ plano::projective::ScaledConstraintMatrix scaledCompatibilityMatrix(const plano:
 /// the steps did before) or its values filled into the pattern built once
 /// (ScaledConstraintMatrix, what they do now).
 void BM_GlobalStepConstraints(benchmark::State& state, bool fill) {
-  const plano::PolygonMesh mesh = grid(state);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::projective::ShapeSpace space(mesh);
   plano::projective::ScaledConstraintMatrix matrix = scaledCompatibilityMatrix(space);
   const std::vector<double> shat = randomScales(space, 1);
@@ -232,7 +227,7 @@ enum class SolverReuse { New, KeptValues, KeptScales };
 void BM_AdmmSetup(benchmark::State& state, BackendChoice choice, SolverReuse reuse) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
-  const plano::PolygonMesh mesh = grid(state);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::projective::ShapeSpace space(mesh);
   const plano::compute::SparseMatrix C[2] = {compatibilityMatrix(space, 1), compatibilityMatrix(space, 2)};
   plano::compute::SparseMatrix P(C[0].cols(), C[0].cols());

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 
+#include "compute/SparsePattern.h"
 #include "core/Error.h"
 #include "core/Timing.h"
 #include "mesh/Planarity.h"
@@ -71,13 +72,13 @@ void buildRows(const Problem& problem, GaussNewtonWorkspace& ws) {
   ws.system.setFromTriplets(triplets.begin(), triplets.end());
   ws.system.makeCompressed();
   ws.diagonalSlots.resize(static_cast<std::size_t>(n));
-  for (Index j = 0; j < n; ++j) ws.diagonalSlots[j] = storedEntrySlot(ws.system, j, j);
+  for (Index j = 0; j < n; ++j) ws.diagonalSlots[j] = compute::storedEntryIndex(ws.system, j, j);
   ws.pairSlotOffset.assign(static_cast<std::size_t>(vertexCount) + 1, 0);
   for (Index v = 0; v < vertexCount; ++v) {
     ws.pairSlotOffset[v] = static_cast<int>(ws.pairSlots.size());
     for (int p = ws.incidenceOffset[v]; p < ws.incidenceOffset[v + 1]; ++p)
       for (int q = ws.incidenceOffset[v]; q < ws.incidenceOffset[v + 1]; ++q)
-        ws.pairSlots.push_back(storedEntrySlot(ws.system, ws.incidences[p].first, ws.incidences[q].first));
+        ws.pairSlots.push_back(compute::storedEntryIndex(ws.system, ws.incidences[p].first, ws.incidences[q].first));
   }
   ws.pairSlotOffset[vertexCount] = static_cast<int>(ws.pairSlots.size());
   ws.jacobian.resize(ws.rows.size());

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "compute/SparsePattern.h"
 #include "core/Error.h"
 #include "core/Timing.h"
 #include "planarize/Monitor.h"
@@ -52,7 +53,7 @@ void buildPattern(const Problem& problem, GuidedProjectionWorkspace& ws) {
   ws.system.setFromTriplets(triplets.begin(), triplets.end());
   ws.system.makeCompressed();
   ws.diagonalSlots.resize(static_cast<std::size_t>(n));
-  for (Index row = 0; row < n; ++row) ws.diagonalSlots[row] = storedEntrySlot(ws.system, row, row);
+  for (Index row = 0; row < n; ++row) ws.diagonalSlots[row] = compute::storedEntryIndex(ws.system, row, row);
   ws.faceSlotOffset.resize(problem.constrainedFaces.size());
   ws.faceSlots.clear();
   ws.faceSlots.reserve(total);
@@ -65,7 +66,7 @@ void buildPattern(const Problem& problem, GuidedProjectionWorkspace& ws) {
         const Index fj = problem.freeIndex[j];
         for (int r = 0; r < 3; ++r)
           for (int col = 0; col < 3; ++col)
-            ws.faceSlots.push_back(fi < 0 || fj < 0 ? -1 : storedEntrySlot(ws.system, 3 * fi + r, 3 * fj + col));
+            ws.faceSlots.push_back(fi < 0 || fj < 0 ? -1 : compute::storedEntryIndex(ws.system, 3 * fi + r, 3 * fj + col));
       }
     }
   }

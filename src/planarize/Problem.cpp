@@ -1,7 +1,6 @@
 #include "planarize/Problem.h"
 
 #include <Eigen/Eigenvalues>
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -135,12 +134,6 @@ void finishSolve(const Problem& problem, const Positions& normalized, bool conve
   measureDisplacement(problem, normalized, info);
   vertices = toOriginal(problem, normalized);
   info.seconds = seconds;
-}
-
-int storedEntrySlot(const compute::SparseMatrix& m, int row, int col) {
-  const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[row];
-  const int* end = m.innerIndexPtr() + m.outerIndexPtr()[row + 1];
-  return static_cast<int>(std::lower_bound(begin, end, col) - m.innerIndexPtr());
 }
 
 }  // namespace plano::planarize::detail

@@ -6,7 +6,6 @@
 #include <span>
 #include <vector>
 
-#include "compute/Backend.h"
 #include "planarize/PlanarizeTypes.h"
 
 namespace plano::planarize::detail {
@@ -55,9 +54,5 @@ void measureDisplacement(const Problem& problem, const Positions& normalized, In
 /// iterate mapped back into `vertices`. `seconds` is the total time spent.
 void finishSolve(const Problem& problem, const Positions& normalized, bool converged, double seconds, Info& info,
                  Positions& vertices);
-
-/// Index into m's stored values of entry (row, col), which must be stored: the slot a
-/// planarizer writes that entry's value into when it refills a fixed pattern.
-int storedEntrySlot(const compute::SparseMatrix& m, int row, int col);
 
 }  // namespace plano::planarize::detail

@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "compute/SparsePattern.h"
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
 #include "compute/vulkan/PcgPushConstants.h"
 #include "core/Cancellation.h"
@@ -131,7 +132,7 @@ K1Terms k1Terms(const compute::SparseMatrix& C, const compute::SparseMatrix& K) 
     for (Eigen::Index r = 0; r < C.rows(); ++r) {
       for (std::int32_t p = outer[r]; p < outer[r + 1]; ++p) {
         for (std::int32_t q = outer[r]; q < outer[r + 1]; ++q) {
-          const std::int32_t e = entryIndex(K, inner[p], inner[q]);
+          const std::int32_t e = compute::storedEntryIndex(K, inner[p], inner[q]);
           if (e < 0) throwDevice("Vulkan ADMM: K's pattern lacks an entry of C^T C");
           visit(e, p, q);
         }

@@ -97,13 +97,6 @@ std::vector<double> DeviceScalars::read() const {
   return all;
 }
 
-std::int32_t entryIndex(const compute::SparseMatrix& A, Index row, Index column) {
-  const int* begin = A.innerIndexPtr() + A.outerIndexPtr()[row];
-  const int* end = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
-  const int* found = std::lower_bound(begin, end, static_cast<int>(column));
-  return found != end && *found == column ? static_cast<std::int32_t>(found - A.innerIndexPtr()) : -1;
-}
-
 namespace {
 
 /// The CSR of a gather: for each destination, the sources that feed it, in increasing order.

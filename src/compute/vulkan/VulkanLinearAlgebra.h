@@ -20,9 +20,6 @@ namespace plano::vk {
 /// so counts above 2^31 - 1 (or negative) are Error(Device) naming `what`.
 std::uint32_t elementCount(std::int64_t value, const char* what);
 
-/// Position of entry (row, column) among the stored entries of the compressed A, or -1:
-/// where a kernel writes a value of a fixed pattern.
-std::int32_t entryIndex(const compute::SparseMatrix& A, Index row, Index column);
 
 /// A compressed-row matrix on the device (uploaded once).
 class DeviceCsrMatrix {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/SparsePattern.h"
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
 #include "core/Error.h"
 
@@ -63,7 +64,7 @@ std::vector<std::int32_t> coarseEntries(const compute::SparseMatrix& fine, const
     const Index coarseRow = b * aggregate[row / b] + row % b;
     for (Index e = fine.outerIndexPtr()[row]; e < fine.outerIndexPtr()[row + 1]; ++e) {
       const Index column = fine.innerIndexPtr()[e];
-      targets[e] = entryIndex(coarse, coarseRow, b * aggregate[column / b] + column % b);
+      targets[e] = compute::storedEntryIndex(coarse, coarseRow, b * aggregate[column / b] + column % b);
       if (targets[e] < 0) throwDevice("Vulkan multigrid: a fine entry has no coarse entry");
     }
   }

@@ -42,7 +42,7 @@ class ObjParser {
       } else {
         if (warnings_ && unknownStatements_++ < 10) {
           warnings_->push_back(cursor_.source() + ":" + std::to_string(cursor_.line()) + ": unknown statement " +
-                               quoted(keyword) + " ignored");
+                               quotedToken(keyword) + " ignored");
         }
         skipStatement();
       }
@@ -98,7 +98,7 @@ class ObjParser {
       std::string_view parts[2] = {rest.substr(0, second),
                                    second == std::string_view::npos ? std::string_view{} : rest.substr(second + 1)};
       if (second != std::string_view::npos && parts[1].find('/') != std::string_view::npos) {
-        cursor_.fail("face corner " + quoted(token) + " has more than three '/'-separated parts");
+        cursor_.fail("face corner " + quotedToken(token) + " has more than three '/'-separated parts");
       }
       for (auto part : parts) {
         if (!part.empty()) cursor_.toInteger(part, "texture/normal index");

@@ -47,7 +47,7 @@ class OffParser {
     if (!cursor_.atEnd()) {
       std::string_view token;
       cursor_.token(token);
-      cursor_.fail("unexpected data " + quoted(token) + " after the " + std::to_string(faceCount_) +
+      cursor_.fail("unexpected data " + quotedToken(token) + " after the " + std::to_string(faceCount_) +
                    " faces declared in the header (the header counts disagree with the body)");
     }
     checkIndices();
@@ -66,8 +66,8 @@ class OffParser {
     std::string_view keyword;
     if (!cursor_.token(keyword)) cursor_.fail("file is empty");
     const OffHeader header = parseHeaderKeyword(keyword);
-    if (!header.ok) cursor_.fail("not an OFF file: expected the header 'OFF', found " + quoted(keyword));
-    if (header.higherDimension) cursor_.fail("header " + quoted(keyword) + ": only 3D OFF files are supported");
+    if (!header.ok) cursor_.fail("not an OFF file: expected the header 'OFF', found " + quotedToken(keyword));
+    if (header.higherDimension) cursor_.fail("header " + quotedToken(keyword) + ": only 3D OFF files are supported");
     std::string_view token;
     if (cursor_.tokenOnLine(token) && token == "BINARY") cursor_.fail("binary OFF files are not supported");
     // The counts may follow the keyword on the same line or start the next line.
@@ -78,7 +78,7 @@ class OffParser {
     faceCount_ = readCount(token, "face count");
     if (cursor_.tokenOnLine(token)) readCount(token, "edge count");  // unused, optional in practice
     if (cursor_.tokenOnLine(token)) {
-      cursor_.failAt(countsLine, "unexpected " + quoted(token) + " after the counts 'V F E'");
+      cursor_.failAt(countsLine, "unexpected " + quotedToken(token) + " after the counts 'V F E'");
     }
     cursor_.skipLine();
   }

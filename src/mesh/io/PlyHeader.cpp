@@ -54,7 +54,7 @@ PlyHeader parsePlyHeader(std::string_view data, const std::string& source) {
   };
   auto type = [&](std::string_view name) {
     const auto t = typeFromName(name);
-    if (!t) cursor.fail("unknown property type " + quoted(name));
+    if (!t) cursor.fail("unknown property type " + quotedToken(name));
     return *t;
   };
   while (true) {
@@ -65,7 +65,7 @@ PlyHeader parsePlyHeader(std::string_view data, const std::string& source) {
       continue;
     }
     if (keyword == "end_header") {
-      if (cursor.tokenOnLine(token)) cursor.fail("unexpected " + quoted(token) + " after 'end_header'");
+      if (cursor.tokenOnLine(token)) cursor.fail("unexpected " + quotedToken(token) + " after 'end_header'");
       cursor.skipLine();
       break;
     }
@@ -82,16 +82,16 @@ PlyHeader parsePlyHeader(std::string_view data, const std::string& source) {
       } else if (encoding == "binary_big_endian") {
         header.encoding = PlyEncoding::BinaryBigEndian;
       } else {
-        cursor.fail("unknown PLY format " + quoted(encoding));
+        cursor.fail("unknown PLY format " + quotedToken(encoding));
       }
       const std::string_view version = required("a version after the format");
-      if (version != "1.0" && version != "1") cursor.fail("unsupported PLY version " + quoted(version));
+      if (version != "1.0" && version != "1") cursor.fail("unsupported PLY version " + quotedToken(version));
       sawFormat = true;
     } else if (keyword == "element") {
       PlyElement element;
       element.name = std::string(required("an element name"));
       element.count = cursor.toInteger(required("an element count"), "element count");
-      if (element.count < 0) cursor.fail("element " + quoted(element.name) + " has a negative count");
+      if (element.count < 0) cursor.fail("element " + quotedToken(element.name) + " has a negative count");
       element.line = cursor.line();
       header.elements.push_back(std::move(element));
     } else if (keyword == "property") {
@@ -110,9 +110,9 @@ PlyHeader parsePlyHeader(std::string_view data, const std::string& source) {
       property.name = std::string(required("a property name"));
       header.elements.back().properties.push_back(std::move(property));
     } else {
-      cursor.fail("unknown header keyword " + quoted(keyword));
+      cursor.fail("unknown header keyword " + quotedToken(keyword));
     }
-    if (cursor.tokenOnLine(token)) cursor.fail("unexpected " + quoted(token) + " at the end of the header line");
+    if (cursor.tokenOnLine(token)) cursor.fail("unexpected " + quotedToken(token) + " at the end of the header line");
     cursor.skipLine();
   }
   if (!sawFormat) cursor.fail("the header has no 'format' line");

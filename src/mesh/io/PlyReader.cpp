@@ -190,10 +190,10 @@ PolygonMesh readBody(const PlyHeader& header, const MeshLayout& layout, Body& bo
         const std::int64_t n = body.integer(property.countType, "list count");
         const bool isIndices = isFace && static_cast<int>(p) == layout.indices;
         const std::string name = "face " + std::to_string(i);
-        if (n < 0) body.fail("list " + quoted(property.name) + " has a negative count");
+        if (n < 0) body.fail("list " + quotedToken(property.name) + " has a negative count");
         if (isIndices && n < 3) body.fail(name + " has " + std::to_string(n) + " vertices (at least 3 needed)");
         if (static_cast<std::uint64_t>(n) > (body.remaining() + 1) / Body::minimumSize(property.type)) {
-          body.fail("list " + quoted(property.name) + " of " + std::to_string(n) +
+          body.fail("list " + quotedToken(property.name) + " of " + std::to_string(n) +
                     " items runs past the end of the file (truncated file)");
         }
         if (isIndices) {

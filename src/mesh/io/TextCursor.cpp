@@ -25,7 +25,7 @@ std::string_view withoutPlus(std::string_view token) {
 
 }  // namespace
 
-std::string quoted(std::string_view token) {
+std::string quotedToken(std::string_view token) {
   constexpr std::size_t kMax = 40;
   std::string out = "'";
   for (std::size_t i = 0; i < token.size() && i < kMax; ++i) {
@@ -115,12 +115,12 @@ double TextCursor::toDouble(std::string_view token, const char* what, bool allow
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
   if (end != digits.data() + digits.size() || digits.empty() ||
       (ec != std::errc() && ec != std::errc::result_out_of_range)) {
-    fail(std::string(what) + " " + quoted(token) + " is not a number");
+    fail(std::string(what) + " " + quotedToken(token) + " is not a number");
   }
   if (ec == std::errc::result_out_of_range) {
-    fail(std::string(what) + " " + quoted(token) + " is out of the range of double precision");
+    fail(std::string(what) + " " + quotedToken(token) + " is out of the range of double precision");
   }
-  if (!allowNonFinite && !std::isfinite(value)) fail(std::string(what) + " " + quoted(token) + " is not finite");
+  if (!allowNonFinite && !std::isfinite(value)) fail(std::string(what) + " " + quotedToken(token) + " is not finite");
   return value;
 }
 
@@ -130,9 +130,9 @@ std::int64_t TextCursor::toInteger(std::string_view token, const char* what) con
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
   if (end != digits.data() + digits.size() || digits.empty() ||
       (ec != std::errc() && ec != std::errc::result_out_of_range)) {
-    fail(std::string(what) + " " + quoted(token) + " is not an integer");
+    fail(std::string(what) + " " + quotedToken(token) + " is not an integer");
   }
-  if (ec == std::errc::result_out_of_range) fail(std::string(what) + " " + quoted(token) + " is too large");
+  if (ec == std::errc::result_out_of_range) fail(std::string(what) + " " + quotedToken(token) + " is too large");
   return value;
 }
 

@@ -57,6 +57,6 @@ class TextCursor {
 };
 
 /// A token for an error message: quoted, at most ~40 characters, control bytes escaped.
-std::string quoted(std::string_view token);
+std::string quotedToken(std::string_view token);
 
 }  // namespace plano::io
