@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -184,6 +185,7 @@ void AdmmSolver::setConstraintValues(const SparseMatrix& C) {
                " for a " + std::to_string(m_) + "x" + std::to_string(n_) + " C");
   }
   kernels_->setConstraintValues(C);
+  scales_.clear();
   factored_ = false;
 }
 
@@ -208,9 +210,14 @@ void fillScaledValues(const ConstraintScaling& scaling, std::span<const double> 
   }
 }
 
-void AdmmSolver::setConstraintScaling(ConstraintScaling scaling) {
+void AdmmSolver::setConstraintScaling(ConstraintScaling scaling, std::span<const double> currentScales) {
+  if (!currentScales.empty() && currentScales.size() != static_cast<std::size_t>(scaling.scaleCount)) {
+    throwUsage("ADMM: " + std::to_string(currentScales.size()) + " current constraint scales for a scaling of " +
+               std::to_string(scaling.scaleCount));
+  }
   kernels_->setConstraintScaling(scaling);
   scaleCount_ = scaling.scaleCount;
+  scales_.assign(currentScales.begin(), currentScales.end());
 }
 
 void AdmmSolver::setConstraintScales(std::span<const double> scales) {
@@ -219,7 +226,12 @@ void AdmmSolver::setConstraintScales(std::span<const double> scales) {
     throwUsage("ADMM: " + std::to_string(scales.size()) + " constraint scales for a scaling of " +
                std::to_string(scaleCount_));
   }
+  // The scales of the last call give the same C (bit for bit): nothing to form, and K stays
+  // valid. A rigid or similar deformation's global steps all take ideal maps, whose fourth
+  // columns are (0, 0, 0, 1): every scale is 1, step after step.
+  if (!scales_.empty() && std::memcmp(scales.data(), scales_.data(), scales.size_bytes()) == 0) return;
   kernels_->setConstraintScales(scales);
+  scales_.assign(scales.begin(), scales.end());
   factored_ = false;
 }
 

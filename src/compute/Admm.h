@@ -304,8 +304,11 @@ class AdmmSolver {
   /// C's values as a scaling of its entries from now on (ConstraintScaling; checked against
   /// C's entry count, Error(Usage)), then new values by their scales: on the device one
   /// scale per corner crosses instead of C's values. Throws Error(Usage) for scales given
-  /// before a scaling or of another count.
-  void setConstraintScaling(ConstraintScaling scaling);
+  /// before a scaling or of another count. Scales equal to the last call's change nothing
+  /// (no kernel runs, nothing is copied to a device, K stays). `currentScales`, when not
+  /// empty, are the scales C's present values were formed from (fillScaledValues): the
+  /// first setConstraintScales with them changes nothing either.
+  void setConstraintScaling(ConstraintScaling scaling, std::span<const double> currentScales = {});
   void setConstraintScales(std::span<const double> scales);
 
   /// AdmmKernels::refineActiveSet on the last solve's iterate; false when the kernels have
@@ -336,6 +339,9 @@ class AdmmSolver {
   std::vector<char> factoredEquality_;
   double factoredRho_ = 0.0;
   std::int32_t scaleCount_ = -1;  ///< Of the scaling given, -1 before one.
+  /// The scales C's values were last formed from; empty when they were not (no scales
+  /// yet, or values given by setConstraintValues).
+  std::vector<double> scales_;
 };
 
 /// Whether A and B are compressed and have the same size and the same nonzero positions.

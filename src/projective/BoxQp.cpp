@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -71,8 +72,9 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
   admm_ = backend_.createAdmmSolver(P_, C_, static_cast<const compute::AdmmSettings&>(settings_));
 }
 
-void BoxQpSolver::setConstraintScaling(const compute::ConstraintScaling& scaling) {
-  admm_->setConstraintScaling(scaling);
+void BoxQpSolver::setConstraintScaling(const compute::ConstraintScaling& scaling,
+                                       std::span<const double> currentScales) {
+  admm_->setConstraintScaling(scaling, currentScales);
 }
 
 void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales) {
@@ -81,7 +83,12 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
     throwUsage("box QP: new constraint values on a different sparsity pattern");
   }
   admm_->setConstraintScales(scales);
+  // The same values (a rigid deformation's steps: every scale 1) leave the all-rows
+  // factorization valid.
+  const auto bytes = static_cast<std::size_t>(C.nonZeros()) * sizeof(double);
+  if (std::memcmp(C.valuePtr(), C_.valuePtr(), bytes) == 0) return;
   std::copy_n(C.valuePtr(), C.nonZeros(), C_.valuePtr());
+  allRowsCurrent_ = false;
 }
 
 BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
@@ -317,7 +324,7 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
   for (Eigen::Index c = 0; c < k; ++c) columns[static_cast<std::size_t>(c)] = c;
   const ActiveSetSolve solved = solveActiveSet(std::vector<char>(m, 1), columns, q, d, Refinement::ForSteps, xs, ys);
   info.polishRefinements = solved.refinements;
-  info.factorizations = solved.factored ? 1 : 0;
+  info.factorizations = solved.newlyFactored ? 1 : 0;
   if (!solved.factored || !solved.solvesConverged || !xs.allFinite() || !ys.allFinite()) return false;
 
   // The multipliers' stationarity holds to sigma times the last step by construction; the
@@ -361,26 +368,34 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
   const compute::SparseMatrix CA = selector * C_;
   const compute::SparseMatrix CAt = CA.transpose();
   const double rhoP = settings_.polishRho;
-  const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
   const bool allRows = CA.rows() == m;
   std::unique_ptr<compute::SpdSolver> created;
   compute::SpdSolver* solver = nullptr;
-  try {
-    if (allRows && allRowsSolver_ && allRowsSolver_->refactor(K)) {
-      solver = allRowsSolver_.get();
-    } else {
-      compute::LinearSolverSettings linear = settings_.linearSolver;
-      linear.measureResidual = false;  // the refinements check their own constraint residual
-      linear.preconditionerBlock = settings_.preconditionerBlock;  // an iterative backend's
-      created = backend_.createSpdSolver(K, linear);
-      solver = created.get();
+  if (allRows && allRowsSolver_ && allRowsCurrent_) {
+    // K = P + sigma I + rhoP C^T C of the values it was factored for: solve with it as it is.
+    solver = allRowsSolver_.get();
+  } else {
+    if (allRows) allRowsCurrent_ = false;
+    const compute::SparseMatrix K = P_ + identity(n, settings_.sigma) + compute::SparseMatrix(rhoP * (CAt * CA));
+    try {
+      if (allRows && allRowsSolver_ && allRowsSolver_->refactor(K)) {
+        solver = allRowsSolver_.get();
+      } else {
+        compute::LinearSolverSettings linear = settings_.linearSolver;
+        linear.measureResidual = false;  // the refinements check their own constraint residual
+        linear.preconditionerBlock = settings_.preconditionerBlock;  // an iterative backend's
+        created = backend_.createSpdSolver(K, linear);
+        solver = created.get();
+      }
+    } catch (const Error&) {
+      return result;
     }
-  } catch (const Error&) {
-    return result;
+    result.newlyFactored = true;
+    // Only a factorization has something to keep (its analysis, reused by refactor); an
+    // iterative backend's solver would hold its copy of K on the device between steps.
+    if (allRows && created && backend_.factorsSpdMatrices()) allRowsSolver_ = std::move(created);
+    if (allRows && solver == allRowsSolver_.get()) allRowsCurrent_ = true;
   }
-  // Only a factorization has something to keep (its analysis, reused by refactor); an
-  // iterative backend's solver would hold its copy of K on the device between steps.
-  if (allRows && created && backend_.factorsSpdMatrices()) allRowsSolver_ = std::move(created);
   result.factored = true;
 
   Eigen::MatrixXd qg(n, g), xg(n, g), b(CA.rows(), g), lambda(CA.rows(), g);
@@ -438,7 +453,7 @@ BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& ba
     kept->setScaledConstraintValues(C.matrix(), scales);
   } else {
     kept = std::make_unique<BoxQpSolver>(backend, P, C.matrix(), settings);
-    kept->setConstraintScaling(C.scaling());
+    kept->setConstraintScaling(C.scaling(), scales);  // C's values are those of `scales`
   }
   return *kept;
 }

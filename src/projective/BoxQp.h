@@ -144,8 +144,9 @@ class BoxQpSolver {
 
   /// C's values as a scaling of its entries from now on (compute::AdmmSolver::
   /// setConstraintScaling), then new values by their scales: the ADMM forms them where it
-  /// runs, and C (its values for those scales) serves the polish here.
-  void setConstraintScaling(const compute::ConstraintScaling& scaling);
+  /// runs, and C (its values for those scales) serves the polish here. `currentScales`:
+  /// as compute::AdmmSolver::setConstraintScaling's.
+  void setConstraintScaling(const compute::ConstraintScaling& scaling, std::span<const double> currentScales = {});
   void setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales);
   /// The rho the next solve starts at (compute::AdmmSolver::rho, setRho).
   double rho() const { return admm_->rho(); }
@@ -157,6 +158,7 @@ class BoxQpSolver {
   /// What solveActiveSet did.
   struct ActiveSetSolve {
     bool factored = false;         ///< Its matrix could be factored (or set up) at all.
+    bool newlyFactored = false;    ///< Factored (or set up) for this solve, not the kept one.
     bool solvesConverged = true;   ///< Every inner solve reached its tolerance.
     int refinements = 0;
   };
@@ -198,6 +200,9 @@ class BoxQpSolver {
   /// object's lifetime, so later systems refactor it, keeping what depends on the pattern
   /// (CHOLMOD's ordering and symbolic analysis).
   std::unique_ptr<compute::SpdSolver> allRowsSolver_;
+  /// allRowsSolver_ holds the factorization of C_'s present values: a next all-rows solve
+  /// reuses it as it is (no refactorization). False after new values of C.
+  bool allRowsCurrent_ = false;
 };
 
 /// The solver of a sequence of QPs whose C keeps one sparsity pattern (a loop's global

@@ -314,16 +314,26 @@ void expectEveryRecordingSolvesLike(vk::Context& context, const BoxQp& first, co
   }
 }
 
+/// C's values as coefficients over `count` scales, entry e taking scale (stride e) mod
+/// count: scales of 1 give C itself.
+compute::ConstraintScaling unitScalingOf(const compute::SparseMatrix& C, std::int32_t count, std::size_t stride) {
+  const auto entries = static_cast<std::size_t>(C.nonZeros());
+  compute::ConstraintScaling scaling;
+  scaling.scaleCount = count;
+  scaling.coefficients.assign(C.valuePtr(), C.valuePtr() + entries);
+  for (std::size_t e = 0; e < entries; ++e) {
+    scaling.scaleOf.push_back(static_cast<std::int32_t>((stride * e) % static_cast<std::size_t>(count)));
+  }
+  return scaling;
+}
+
 TEST_F(VulkanAdmm, ConstraintScalesGiveTheSolveOfTheirValuesOnBothBackends) {
   // C's values as coefficient / scale per entry (the projective global steps' form): after
   // the scaling is given once, new scales must solve as the values they stand for, given
   // directly. On the device the values are formed there from one scale per index.
   const BoxQp first = randomBoxQp(24, 16, 31);
   const auto entries = static_cast<std::size_t>(first.C.nonZeros());
-  compute::ConstraintScaling scaling;
-  scaling.scaleCount = 17;
-  scaling.coefficients.assign(first.C.valuePtr(), first.C.valuePtr() + entries);
-  for (std::size_t e = 0; e < entries; ++e) scaling.scaleOf.push_back(static_cast<std::int32_t>((7 * e) % 17));
+  const compute::ConstraintScaling scaling = unitScalingOf(first.C, 17, 7);
   std::mt19937 random(32);
   std::uniform_real_distribution<double> factor(0.5, 1.5);
   std::vector<double> scales(17);
@@ -360,6 +370,68 @@ TEST_F(VulkanAdmm, ConstraintScalesGiveTheSolveOfTheirValuesOnBothBackends) {
   compute::ConstraintScaling outOfRange = scaling;
   outOfRange.scaleOf[3] = 17;
   EXPECT_THROW(byScales->setConstraintScaling(outOfRange), Error);
+}
+
+TEST_F(VulkanAdmm, RepeatedConstraintScalesCopyNothingAndKeepTheFactorization) {
+  // A rigid deformation's global steps give the same scales (all 1) step after step: the
+  // solver must neither copy them to the device again nor form K again for them, and must
+  // still take new scales after them.
+  const BoxQp qp = randomBoxQp(24, 16, 33);
+  const compute::ConstraintScaling scaling = unitScalingOf(qp.C, 5, 1);
+  const std::vector<double> ones(5, 1.0);  // C's own values
+  const compute::AdmmSettings settings = tightSettings();
+
+  compute::CpuBackend cpu;
+  auto host = cpu.createAdmmSolver(qp.P, qp.C, settings);
+  host->setConstraintScaling(scaling);
+  host->setConstraintScales(ones);
+  const AdmmRun hostFirst = runAdmm(*host, qp);
+  EXPECT_GE(hostFirst.info.factorizations, 1);
+  // Warm-started at its solution, the same problem converges at the first check, at the
+  // rho it ended with: on the kept factorization when the scales changed nothing.
+  BoxQp warm = qp;
+  warm.x = hostFirst.x;
+  warm.y = hostFirst.y;
+  host->setConstraintScales(ones);
+  const AdmmRun hostAgain = runAdmm(*host, warm);
+  EXPECT_EQ(hostAgain.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(hostAgain.info.factorizations, 0);
+  EXPECT_LT(relativeDifference(hostAgain.x, hostFirst.x), 1e-8);
+
+  // Given with the scaling as the scales C's values stand for, they are not copied even once.
+  auto device = deviceSolver(context(), qp, settings, kRecordings[0]);
+  const vk::TransferCounts beforeScaling = context().transfers();
+  device->setConstraintScaling(scaling, ones);
+  const vk::TransferCounts afterScaling = context().transfers();
+  device->setConstraintScales(ones);
+  EXPECT_EQ(context().transfers().uploadedBytes, afterScaling.uploadedBytes);
+  EXPECT_GT(afterScaling.uploadedBytes, beforeScaling.uploadedBytes);  // the coefficients and indices
+  EXPECT_THROW(device->setConstraintScaling(scaling, std::vector<double>(4, 1.0)), Error);
+  device->setConstraintScaling(scaling, ones);
+  const AdmmRun first = runAdmm(*device, qp);
+  const vk::TransferCounts before = context().transfers();
+  device->setConstraintScales(ones);
+  const vk::TransferCounts after = context().transfers();
+  EXPECT_EQ(after.uploads, before.uploads);
+  EXPECT_EQ(after.uploadedBytes, before.uploadedBytes);
+  BoxQp deviceWarm = qp;
+  deviceWarm.x = first.x;
+  deviceWarm.y = first.y;
+  const AdmmRun again = runAdmm(*device, deviceWarm);
+  EXPECT_EQ(again.info.status, compute::AdmmStatus::Solved);
+  EXPECT_LT(relativeDifference(again.x, first.x), 1e-8);
+
+  // Other scales after the repeated ones are formed: the device solves them as the host.
+  std::vector<double> other(5);
+  for (std::size_t i = 0; i < other.size(); ++i) other[i] = 0.6 + 0.2 * static_cast<double>(i);
+  const vk::TransferCounts beforeOther = context().transfers();
+  device->setConstraintScales(other);
+  EXPECT_EQ(context().transfers().uploadedBytes - beforeOther.uploadedBytes, 5u * sizeof(double));
+  host->setConstraintScales(other);
+  const AdmmRun hostOther = runAdmm(*host, qp);
+  const AdmmRun deviceOther = runAdmm(*device, qp);
+  EXPECT_GT(relativeDifference(hostOther.x, hostFirst.x), 1e-6);  // the new C changed the solution
+  EXPECT_LT(relativeDifference(deviceOther.x, hostOther.x), 1e-8);
 }
 
 TEST_F(VulkanAdmm, ASetRhoStartsTheNextSolveThereOnBothBackends) {

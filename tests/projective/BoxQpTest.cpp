@@ -186,6 +186,52 @@ TEST(BoxQp, DirectSolvesOfOneSolverFactorOnePatternOnce) {
   EXPECT_LT((x2 - xFresh).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST(BoxQp, DirectSolvesWithUnchangedConstraintValuesReuseTheFactorization) {
+  // A rigid deformation's global steps give C the same values step after step: the kept
+  // factorization of K = P + sigma I + rhoP C^T C serves them as it is; new values factor.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 23);
+  compute::ConstraintScaling scaling;
+  scaling.scaleCount = 3;
+  const auto entries = static_cast<std::size_t>(qp.C.nonZeros());
+  scaling.coefficients.assign(qp.C.valuePtr(), qp.C.valuePtr() + entries);
+  for (std::size_t e = 0; e < entries; ++e) scaling.scaleOf.push_back(static_cast<std::int32_t>(e % 3));
+  const std::vector<double> ones(3, 1.0);
+  compute::CpuBackend cpu;
+  BoxQpSolver kept(cpu, qp.P, qp.C);
+  kept.setConstraintScaling(scaling, ones);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo first = kept.solve(qp.q, qp.d, qp.d, x, y);
+  ASSERT_EQ(first.status, BoxQpStatus::Solved);
+  EXPECT_EQ(first.factorizations, 1);
+
+  const Eigen::MatrixXd q2 = -qp.q;
+  kept.setScaledConstraintValues(qp.C, ones);
+  Eigen::MatrixXd x2, y2;
+  const BoxQpInfo again = kept.solve(q2, qp.d, qp.d, x2, y2);
+  ASSERT_EQ(again.status, BoxQpStatus::Solved);
+  EXPECT_TRUE(again.direct);
+  EXPECT_EQ(again.factorizations, 0);
+  BoxQpSolver fresh(cpu, qp.P, qp.C);
+  Eigen::MatrixXd xFresh, yFresh;
+  ASSERT_EQ(fresh.solve(q2, qp.d, qp.d, xFresh, yFresh).status, BoxQpStatus::Solved);
+  EXPECT_LT((x2 - xFresh).cwiseAbs().maxCoeff(), 1e-12);
+
+  const std::vector<double> other{0.5, 1.25, 2.0};
+  compute::SparseMatrix C2 = qp.C;
+  compute::fillScaledValues(scaling, other, C2.valuePtr());
+  const Eigen::MatrixXd d2 = C2 * x;  // consistent for the new C
+  kept.setScaledConstraintValues(C2, other);
+  Eigen::MatrixXd x3, y3;
+  const BoxQpInfo changed = kept.solve(qp.q, d2, d2, x3, y3);
+  ASSERT_EQ(changed.status, BoxQpStatus::Solved);
+  EXPECT_EQ(changed.factorizations, 1);
+  BoxQpSolver freshChanged(cpu, qp.P, C2);
+  Eigen::MatrixXd x4, y4;
+  ASSERT_EQ(freshChanged.solve(qp.q, d2, d2, x4, y4).status, BoxQpStatus::Solved);
+  EXPECT_LT((x3 - x4).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((C2 * x3 - d2).cwiseAbs().maxCoeff(), 1e-10);
+}
+
 TEST(BoxQp, ADirectSolveThatCannotFactorFallsBackToTheAdmm) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 3, 19);
   CountingBackend failing(/*failFirst=*/true);
