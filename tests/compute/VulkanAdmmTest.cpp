@@ -23,7 +23,9 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "mesh/Generators.h"
+#include "projective/BoxQp.h"
 #include "projective/GlobalStep.h"
+#include "projective/ScaledConstraintMatrix.h"
 #include "projective/ShapeSpace.h"
 #include "support/CpuForwardingBackend.h"
 
@@ -432,6 +434,28 @@ TEST_F(VulkanAdmm, RepeatedConstraintScalesCopyNothingAndKeepTheFactorization) {
   const AdmmRun deviceOther = runAdmm(*device, qp);
   EXPECT_GT(relativeDifference(hostOther.x, hostFirst.x), 1e-6);  // the new C changed the solution
   EXPECT_LT(relativeDifference(deviceOther.x, hostOther.x), 1e-8);
+}
+
+TEST_F(VulkanAdmm, AKeptSolverGivenTheScalesItWasBuiltForCopiesNothing) {
+  // projective::keptSolver builds its solver from C filled for the first step's scales; a
+  // later step with the same scales (every step of a rigid deformation: all 1) must copy
+  // nothing to the device, and one with other scales only those.
+  const Eigen::RowVector4d p(0.5, -0.25, 1.0, 1.0);
+  projective::ScaledConstraintMatrix C(2, 2, 4, {{0, 0, p, 0}, {0, 1, -p, 1}, {1, 0, p, 2}, {1, 1, -p, 3}});
+  compute::SparseMatrix P(8, 8);
+  P.setIdentity();
+  const std::vector<double> ones(4, 1.0), other{0.5, 1.0, 2.0, 4.0};
+  std::unique_ptr<projective::BoxQpSolver> kept;
+  C.fill(ones);
+  projective::keptSolver(kept, backend(), P, C, ones, {});
+  vk::TransferCounts before = context().transfers();
+  projective::keptSolver(kept, backend(), P, C, ones, {});
+  EXPECT_EQ(context().transfers().uploadedBytes, before.uploadedBytes);
+  EXPECT_EQ(context().transfers().uploads, before.uploads);
+  C.fill(other);
+  before = context().transfers();
+  projective::keptSolver(kept, backend(), P, C, other, {});
+  EXPECT_EQ(context().transfers().uploadedBytes - before.uploadedBytes, 4u * sizeof(double));
 }
 
 TEST_F(VulkanAdmm, ASetRhoStartsTheNextSolveThereOnBothBackends) {
