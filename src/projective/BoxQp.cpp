@@ -84,9 +84,9 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
   }
   admm_->setConstraintScales(scales);
   // The same values (a rigid deformation's steps: every scale 1) leave the all-rows
-  // factorization valid.
+  // factorization valid. (A C without entries may have no value array to compare.)
   const auto bytes = static_cast<std::size_t>(C.nonZeros()) * sizeof(double);
-  if (std::memcmp(C.valuePtr(), C_.valuePtr(), bytes) == 0) return;
+  if (bytes == 0 || std::memcmp(C.valuePtr(), C_.valuePtr(), bytes) == 0) return;
   std::copy_n(C.valuePtr(), C.nonZeros(), C_.valuePtr());
   allRowsCurrent_ = false;
 }
