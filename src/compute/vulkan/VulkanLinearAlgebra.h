@@ -20,7 +20,6 @@ namespace plano::vk {
 /// so counts above 2^31 - 1 (or negative) are Error(Device) naming `what`.
 std::uint32_t elementCount(std::int64_t value, const char* what);
 
-
 /// A compressed-row matrix on the device (uploaded once).
 class DeviceCsrMatrix {
  public:
