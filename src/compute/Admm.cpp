@@ -73,12 +73,12 @@ class HostAdmmKernels final : public AdmmKernels {
     Ct_ = C_.transpose();
   }
 
-  void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
-    q_ = q;
+  void start(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+             const DeviceMatrix& x, const Eigen::MatrixXd& y) override {
+    q_ = q.values();
     lower_ = lower;
     upper_ = upper;
-    x_ = x.size() > 0 ? x : Eigen::MatrixXd::Zero(q.rows(), q.cols());
+    x_ = x.size() > 0 ? x.values() : Eigen::MatrixXd::Zero(q.rows(), q.cols());
     y_ = y.size() > 0 ? y : Eigen::MatrixXd::Zero(lower.rows(), q.cols());
     z_ = (C_ * x_).cwiseMax(lower_).cwiseMin(upper_);
     xTilde_ = x_;
@@ -255,6 +255,18 @@ bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::Matr
   return refined;
 }
 
+double AdmmSolver::violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
+                               const SparseMatrix& C) {
+  if (bounds.centre.rows() != m_ || bounds.relaxed.size() != static_cast<std::size_t>(m_) || x.rows() != n_ ||
+      q.rows() != n_ || x.cols() != bounds.centre.cols() || q.cols() != x.cols() || C.rows() != m_ ||
+      C.cols() != n_) {
+    throwUsage("ADMM: a violation needs q and x n x k, an m x k centre, m flags and an m x n C");
+  }
+  if (m_ == 0 || x.cols() == 0) return 0.0;
+  if (const auto measured = kernels_->violationAt(q, bounds, x)) return *measured;
+  return (C * x.values() - bounds.centre).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
+}
+
 void AdmmSolver::setRho(double rho) {
   if (!(rho > 0.0) || !std::isfinite(rho)) throwUsage("ADMM: rho must be a finite number > 0");
   rho_ = rho;
@@ -299,8 +311,8 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds
   return info;
 }
 
-AdmmInfo AdmmSolver::iterate(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                             const RelaxedBounds* relaxed, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                             const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y) {
   if (relaxed) {
     if (relaxed->centre.rows() != m_ || relaxed->centre.cols() != q.cols() ||
         relaxed->relaxed.size() != static_cast<std::size_t>(m_)) {

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -209,12 +210,13 @@ class AdmmKernels {
   virtual void setConstraintScales(std::span<const double> scales) = 0;
   /// Load q (n x k), bounds (m x k) and warm starts x (n x k) and y (m x k), each of which
   /// may be empty for zero (set where the kernels keep the iterate: nothing copied to a
-  /// device); z = clamp(C x, l, u), xTilde = x.
-  virtual void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                     const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) = 0;
+  /// device); z = clamp(C x, l, u), xTilde = x. q and x may be device matrices (DeviceMatrix):
+  /// kernels that keep the iterate where those live bind them, others read their values.
+  virtual void start(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                     const DeviceMatrix& x, const Eigen::MatrixXd& y) = 0;
   /// start() with l and u given as a relaxation (RelaxedBounds, checked by the caller). The
   /// default forms them on the host; kernels that keep the iterate on a device form them there.
-  virtual void startRelaxed(const Eigen::MatrixXd& q, const RelaxedBounds& bounds, const Eigen::MatrixXd& x,
+  virtual void startRelaxed(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
                             const Eigen::MatrixXd& y) {
     start(q, bounds.lower(), bounds.upper(), x, y);
   }
@@ -266,6 +268,14 @@ class AdmmKernels {
   /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN (or +Inf)
   /// when C x is not finite.
   virtual double boundViolation();
+  /// Start (as startRelaxed, y zero) with bounds.centre as both bounds, and return
+  /// boundViolation(): max |C x - centre|, measured where the kernels keep the iterate.
+  /// nullopt (nothing started) for kernels that do not keep it there.
+  virtual std::optional<double> violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds,
+                                            const DeviceMatrix& x) {
+    (void)q, (void)bounds, (void)x;
+    return std::nullopt;
+  }
   /// Make the iterate the one the refinements started from (the ADMM's), after
   /// refinements with keepResult that the caller rejects.
   virtual void discardRefinement();
@@ -285,8 +295,16 @@ class AdmmSolver {
   /// solve() without fetching the iterate: it stays where the kernels keep it, for the
   /// polish's steps below, until download(). `relaxed`, when not null, is the bounds' form
   /// the kernels start from (lower and upper must be its l and u).
-  AdmmInfo iterate(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                   const RelaxedBounds* relaxed, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y);
+  /// q and x may be device matrices (AdmmKernels::start).
+  AdmmInfo iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                   const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y);
+  /// max |C x - centre| over all rows and columns of relaxed bounds (their centre; epsilon
+  /// is not used), measured where the kernels keep the iterate: they are started at x (the
+  /// next solve starts again), and a q, centre and flags that the next start shares are
+  /// loaded for it already. For kernels that do not keep the iterate (no boundViolation),
+  /// the host's product with `C` (these kernels' C). NaN when C x is not finite.
+  double violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
+                     const SparseMatrix& C);
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) { kernels_->download(x, y, z); }
   void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) { kernels_->downloadSolution(x, y); }
 

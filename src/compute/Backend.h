@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "compute/DeviceMatrix.h"
 #include "mesh/PolygonMesh.h"
 
 namespace plano::compute {
@@ -52,6 +53,17 @@ enum class IdealMapMethod : std::int32_t {
 struct IdealMaps {
   std::vector<Eigen::Matrix4d> maps;     ///< #F affine maps [[s R, 0], [t, 1]], T(3, 3) = 1.
   std::vector<IdealMapMethod> methods;   ///< #F.
+};
+
+/// Ideal maps a backend may keep where it computed them (Backend::fitIdealMapsOnDevice). They
+/// are affine, [[s R, 0], [t, 1]]: their fourth columns (0, 0, 0, 1) need no storage.
+struct DeviceIdealMaps {
+  /// 4 #F x 3: rows 4 f .. 4 f + 3 hold the first three columns of face f's map (the
+  /// stacking of the projective global step's unknowns, projective/GlobalStep.h).
+  DeviceMatrix linearColumns;
+  Index cornerProcrustes = 0;    ///< Faces whose map came from IdealMapMethod::CornerProcrustes.
+  Index centroidsAtInfinity = 0; ///< Faces without an ideal map (IdealMapMethod::CentroidAtInfinity).
+  Index firstCentroidAtInfinity = -1;  ///< The lowest such face, or -1.
 };
 
 /// Backend::closestIdealMaps's input checks, one for every backend: Error(Usage) unless
@@ -155,6 +167,12 @@ class Backend {
   /// The default runs the two calls.
   virtual void fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
                             IdealMaps& out);
+
+  /// fitIdealMaps with the maps left where they were computed: the host reads only the
+  /// methods' tallies, and the maps when a caller reads linearColumns' values. The default
+  /// runs fitIdealMaps and keeps its maps on the host.
+  virtual void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+                                    bool similar, DeviceIdealMaps& out);
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;

@@ -43,6 +43,25 @@ void Backend::fitIdealMaps(const FaceList& faces, const Positions& source, const
   closestIdealMaps(faces, source, fits.maps, &target, similar, out);
 }
 
+void Backend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+                                   bool similar, DeviceIdealMaps& out) {
+  IdealMaps ideal;
+  fitIdealMaps(faces, source, target, similar, ideal);
+  const auto faceCount = static_cast<Index>(ideal.maps.size());
+  Eigen::MatrixXd columns(4 * static_cast<Eigen::Index>(faceCount), 3);
+  out.cornerProcrustes = 0;
+  out.centroidsAtInfinity = 0;
+  out.firstCentroidAtInfinity = -1;
+  for (Index f = 0; f < faceCount; ++f) {
+    columns.middleRows<4>(4 * static_cast<Eigen::Index>(f)) = ideal.maps[f].leftCols<3>();
+    if (ideal.methods[f] == IdealMapMethod::CornerProcrustes) ++out.cornerProcrustes;
+    if (ideal.methods[f] == IdealMapMethod::CentroidAtInfinity) {
+      if (out.centroidsAtInfinity++ == 0) out.firstCentroidAtInfinity = f;
+    }
+  }
+  out.linearColumns = DeviceMatrix(std::move(columns));
+}
+
 BackendChoice parseBackendChoice(const std::string& text) {
   if (text == "cpu") return BackendChoice::Cpu;
   if (text == "vulkan") return BackendChoice::Vulkan;

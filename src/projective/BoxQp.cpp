@@ -91,34 +91,52 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
   allRowsCurrent_ = false;
 }
 
-BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower,
+                             const Eigen::MatrixXd& upper, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  const BoxQpInfo info = solve(q, lower, upper, nullptr, nullptr, x, y);
+  if (!settings_.returnDuals) y.resize(0, 0);
+  return info;
+}
+
+BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                              Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
-  const BoxQpInfo info = solve(q, lower, upper, nullptr, x, y);
+  const BoxQpInfo info = solve(q, bounds.lower(), bounds.upper(), &bounds, nullptr, x, y);
   if (!settings_.returnDuals) y.resize(0, 0);
   return info;
 }
 
-BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
-                             Eigen::MatrixXd& y) {
-  const BoxQpInfo info = solve(q, bounds.lower(), bounds.upper(), &bounds, x, y);
+BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                             const compute::DeviceMatrix& start, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+  const BoxQpInfo info = solve(q, bounds.lower(), bounds.upper(), &bounds, &start, x, y);
   if (!settings_.returnDuals) y.resize(0, 0);
   return info;
 }
 
-BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                             const compute::RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+double BoxQpSolver::violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                                const compute::DeviceMatrix& x) {
+  return admm_->violationAt(q, bounds, x, C_);
+}
+
+BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower,
+                             const Eigen::MatrixXd& upper, const compute::RelaxedBounds* relaxed,
+                             const compute::DeviceMatrix* start, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
   if (lower.size() > 0 && lower == upper) {
     const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
                         (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
     BoxQpInfo info;
-    if (direct && solveEqualities(q, lower, x, y, info)) return info;
+    if (direct) {
+      // The direct solve runs here: it reads the values (a device matrix's copy comes over).
+      if (start) x = start->values();
+      if (solveEqualities(q.values(), lower, x, y, info)) return info;
+    }
     // The ADMM of an all-equality problem starts at the initial rho, not at the one the
     // last solve ended at (raised there by the stiff rows): on a 16-face deformation
     // (21 steps at ε = 0) on lavapipe the same 430 ADMM iterations, but 45 901 -> 18 358
     // PCG iterations in its solves with K, which that rho made stiffer (4.8 -> 2.5 s).
     admm_->setRho(settings_.rho);
   }
-  const compute::AdmmInfo admm = admm_->iterate(q, lower, upper, relaxed, x, y);
+  const compute::AdmmInfo admm =
+      start ? admm_->iterate(q, lower, upper, relaxed, *start, y) : admm_->iterate(q, lower, upper, relaxed, x, y);
   BoxQpInfo info;
   info.status = toBoxQpStatus(admm.status);
   info.iterations = admm.iterations;
@@ -133,7 +151,7 @@ BoxQpInfo BoxQpSolver::solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lo
   } else if (polishing) {
     Eigen::MatrixXd z;  // the host's polish needs the whole iterate
     admm_->download(x, y, z);
-    info.polished = polish(q, lower, upper, z, x, y, info.polishRefinements);
+    info.polished = polish(q.values(), lower, upper, z, x, y, info.polishRefinements);
   } else {
     admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
   }

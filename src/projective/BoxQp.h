@@ -134,13 +134,24 @@ class BoxQpSolver {
   ///         without BoxQpSettings::returnDuals.
   /// Rows whose bounds are equal in every column are equality rows. K changes when the
   /// equality pattern or rho changed since the last solve.
-  BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+  /// q may be a device matrix (compute::DeviceMatrix): the ADMM binds it where it runs,
+  /// the host steps (a direct solve, the host's polish) read its values.
+  BoxQpInfo solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
   /// The same with the bounds as a relaxation (compute::RelaxedBounds: an ε schedule's
   /// attempts), which the ADMM forms where it runs.
-  BoxQpInfo solve(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
+  BoxQpInfo solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds, Eigen::MatrixXd& x,
                   Eigen::MatrixXd& y);
+  /// The same with x's warm start given apart (n x k, possibly a device matrix: the global
+  /// step's targets, whose negation is q); x receives the solution.
+  BoxQpInfo solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                  const compute::DeviceMatrix& start, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
+
+  /// max |C x - bounds.centre| (compute::AdmmSolver::violationAt: where the ADMM runs, which
+  /// then holds q and the bounds' centre for the next solve).
+  double violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                     const compute::DeviceMatrix& x);
 
   /// C's values as a scaling of its entries from now on (compute::AdmmSolver::
   /// setConstraintScaling), then new values by their scales: the ADMM forms them where it
@@ -163,9 +174,11 @@ class BoxQpSolver {
     int refinements = 0;
   };
 
-  /// Both solves': `relaxed` (when not null) is the bounds' form to hand the ADMM.
-  BoxQpInfo solve(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                  const compute::RelaxedBounds* relaxed, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
+  /// The solves': `relaxed` (when not null) is the bounds' form to hand the ADMM, `start`
+  /// (when not null) x's warm start (else x on entry).
+  BoxQpInfo solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                  const compute::RelaxedBounds* relaxed, const compute::DeviceMatrix* start, Eigen::MatrixXd& x,
+                  Eigen::MatrixXd& y);
   /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
   /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
   /// by the kernels; only the sides found (a byte per four rows and columns), the active

@@ -71,8 +71,9 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       throwIfCancelled("deformation");
       transfersBefore = backend_.transfers();
-      const auto ideal = fittedIdealMaps(backend_, space_, positions, settings_.energy);
-      const GlobalStepInfo step = global_.solve(ideal, targets, maps);
+      // The ideal maps stay where the backend computed them: the global step's QP reads them there.
+      const compute::DeviceMatrix ideal = fittedIdealMapsOnDevice(backend_, space_, positions, settings_.energy);
+      const GlobalStepInfo step = global_.solveAffine(ideal, targets, maps);
       const Positions next = space_.positions(maps.maps);
       const DeformationIteration it = record(DeformationPhase::Ideal, step, next);
       positions = next;

@@ -100,29 +100,52 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     throwUsage("global step: " + std::to_string(targets.size()) + " target maps for " + std::to_string(faceCount) +
                " faces");
   }
-  if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
-    throwUsage("global step: " + std::to_string(positions.rows()) + " positions for " +
-               std::to_string(constrained_.size()) + " constrained vertices");
-  }
   for (Index f = 0; f < faceCount; ++f) {
     if (!targets[f].allFinite()) throwNumerical("global step: the target map of face " + std::to_string(f) + " is not finite");
   }
-
-  GlobalStepInfo info;
-  const std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  Index nonPositive = 0;
   for (Index c = 0; c < space_.cornerCount(); ++c) {
-    if (shat[c] <= 0.0) ++info.nonPositiveScales;
+    if (shat[c] <= 0.0) ++nonPositive;
     if (!(std::abs(shat[c]) > kMinimumReciprocalScale)) {
       throwNumerical("global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
                      " sends vertex " + std::to_string(space_.faces().indices()[c]) +
                      " to infinity (reciprocal scale factor " + formatDouble(shat[c]) + ")");
     }
   }
+  Eigen::MatrixXd T(4 * faceCount, 3);
+  for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
+  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), std::move(shat), positions, result);
+  info.nonPositiveScales = nonPositive;
+  for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = targets[f].col(3);
+  return info;
+}
 
+GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
+                                       FaceMaps& result) {
+  const Index faceCount = space_.faceCount();
+  if (linearColumns.rows() != 4 * static_cast<Eigen::Index>(faceCount) || linearColumns.cols() != 3) {
+    throwUsage("global step: affine targets of " + std::to_string(linearColumns.rows()) + " x " +
+               std::to_string(linearColumns.cols()) + " for " + std::to_string(faceCount) + " faces (need 4 #F x 3)");
+  }
+  // Fourth columns (0, 0, 0, 1): every corner's reciprocal scale factor is 1.
+  GlobalStepInfo info = project(linearColumns, std::vector<double>(space_.cornerCount(), 1.0), positions, result);
+  for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
+  return info;
+}
+
+GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, std::vector<double> shat,
+                                   const Positions& positions, FaceMaps& result) {
+  const Index faceCount = space_.faceCount();
+  if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
+    throwUsage("global step: " + std::to_string(positions.rows()) + " positions for " +
+               std::to_string(constrained_.size()) + " constrained vertices");
+  }
+
+  GlobalStepInfo info;
   // C_s (values 1/shat of each row's corners) and d for columns 0..2 (d differs per column
   // only on positional rows).
   const auto m = static_cast<Eigen::Index>(rows_.size());
-  const Index n = 4 * faceCount;
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
   std::vector<char> positional(m, 0);
   for (Eigen::Index r = 0; r < m; ++r) {
@@ -137,10 +160,27 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   }
   const compute::SparseMatrix& C = constraints_.fill(shat);
 
-  Eigen::MatrixXd T(n, 3);
-  for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
-  const Eigen::MatrixXd q = -T;
-  info.initialViolation = m > 0 ? (C * T - d).cwiseAbs().maxCoeff() : 0.0;
+  // C's pattern depends on the topology (and the constrained vertices) only: one solver
+  // for the object's lifetime.
+  BoxQpSettings qpSettings = settings_.qp;
+  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+  qpSettings.returnDuals = false;      // every attempt starts from zero duals
+  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
+  compute::RelaxedBounds bounds{std::move(d), std::vector<char>(m), 0.0};
+  for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
+
+  // q = -T; measured where the QP runs, which keeps q and d for the attempts.
+  const compute::DeviceMatrix q = T.negated();
+  info.initialViolation = m > 0 ? qp.violationAt(q, bounds, T) : 0.0;
+  if (!std::isfinite(info.initialViolation)) {  // d is finite: a target is not
+    const Eigen::MatrixXd& values = T.values();
+    for (Index f = 0; f < faceCount; ++f) {
+      if (!values.middleRows<4>(4 * f).allFinite()) {
+        throwNumerical("global step: the target map of face " + std::to_string(f) + " is not finite");
+      }
+    }
+    throwNumerical("global step: the targets' constraint violation is not finite");
+  }
 
   std::vector<double> schedule;
   const double eps0 = settings_.initialEpsilonFraction * info.initialViolation;
@@ -150,25 +190,17 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
     for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
   }
 
-  // C's pattern depends on the topology (and the constrained vertices) only: one solver
-  // for the object's lifetime.
-  BoxQpSettings qpSettings = settings_.qp;
-  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  qpSettings.returnDuals = false;      // every attempt starts from zero duals
-  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
-  Eigen::MatrixXd x = T;
+  Eigen::MatrixXd x;
   bool solved = false;
-  compute::RelaxedBounds bounds{d, std::vector<char>(m), 0.0};
-  for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
   for (double eps : schedule) {
     throwIfCancelled("the global step");
     bounds.epsilon = eps;
     // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
     // (its certificate), a poor warm start for the next eps.
-    Eigen::MatrixXd xTry = T;
+    Eigen::MatrixXd xTry;
     Eigen::MatrixXd yTry;
     const double startRho = qp.rho();
-    const BoxQpInfo qpInfo = qp.solve(q, bounds, xTry, yTry);
+    const BoxQpInfo qpInfo = qp.solve(q, bounds, T, xTry, yTry);
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
@@ -177,7 +209,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
       throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
     }
     if (isSolved(qpInfo.status)) {
-      x = xTry;
+      x = std::move(xTry);
       info.epsilon = eps;
       info.polished = qpInfo.polished;
       info.polishRefinements = qpInfo.polishRefinements;
@@ -205,7 +237,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
                    " ADMM iterations)");
   }
 
-  const Eigen::MatrixXd residual = m > 0 ? Eigen::MatrixXd((C * x - d).cwiseAbs()) : Eigen::MatrixXd();
+  const Eigen::MatrixXd residual = m > 0 ? Eigen::MatrixXd((C * x - bounds.centre).cwiseAbs()) : Eigen::MatrixXd();
   for (Eigen::Index r = 0; r < m; ++r) {
     const double value = residual.row(r).maxCoeff();
     info.constraintResidual = std::max(info.constraintResidual, value);
@@ -213,11 +245,8 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   }
 
   result.maps.resize(faceCount);
-  for (Index f = 0; f < faceCount; ++f) {
-    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
-    result.maps[f].col(3) = targets[f].col(3);
-  }
-  result.reciprocalScales = shat;
+  for (Index f = 0; f < faceCount; ++f) result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
+  result.reciprocalScales = std::move(shat);
   return info;
 }
 

@@ -110,6 +110,13 @@ class GlobalStep {
   /// Throws Error(Numerical) when a target sends a corner to infinity (shat ~ 0), when the
   /// iteration produces NaN, or when the eps schedule is exhausted.
   GlobalStepInfo solve(const std::vector<Eigen::Matrix4d>& targets, const Positions& positions, FaceMaps& result);
+  /// The same for affine targets (fourth columns (0, 0, 0, 1): ideal maps) given by their
+  /// first three columns, 4 #F x 3 (compute::DeviceIdealMaps::linearColumns), which may stay
+  /// on the device that computed them: the QP forms its linear term, warm start and the
+  /// initial violation there. Throws as solve() (a non-finite target shows as a non-finite
+  /// initial violation), and Error(Usage) for targets of the wrong size.
+  GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
+                             FaceMaps& result);
 
   const std::vector<Index>& constrainedVertices() const { return constrained_; }
   const GlobalStepSettings& settings() const { return settings_; }
@@ -122,6 +129,11 @@ class GlobalStep {
     Index cornerB;
     Index constrainedSlot;  ///< Index into constrained_ for positional rows, else -1.
   };
+
+  /// Both solves after their target checks: T (4 #F x 3) the targets' first three columns,
+  /// shat their reciprocal scales; writes the maps' first three columns and the scales.
+  GlobalStepInfo project(const compute::DeviceMatrix& T, std::vector<double> shat, const Positions& positions,
+                         FaceMaps& result);
 
   compute::Backend& backend_;
   const ShapeSpace& space_;

@@ -8,6 +8,11 @@
 namespace plano::projective {
 namespace {
 
+[[noreturn]] void throwCentroidAtInfinity(Index face) {
+  throwNumerical("closest ideal map: the fitted map of face " + std::to_string(face) +
+                 " sends the face centroid to infinity");
+}
+
 /// The maps of a batched ideal-map call, after counting the corner fallbacks and refusing a
 /// face whose centroid the fit sends to infinity (no ideal map then).
 std::vector<Eigen::Matrix4d> checkedMaps(compute::IdealMaps ideal, Index* fallbacks) {
@@ -19,9 +24,7 @@ std::vector<Eigen::Matrix4d> checkedMaps(compute::IdealMaps ideal, Index* fallba
       case compute::IdealMapMethod::CornerProcrustes:
         if (fallbacks) ++*fallbacks;
         break;
-      case compute::IdealMapMethod::CentroidAtInfinity:
-        throwNumerical("closest ideal map: the fitted map of face " + std::to_string(f) +
-                       " sends the face centroid to infinity");
+      case compute::IdealMapMethod::CentroidAtInfinity: throwCentroidAtInfinity(f);
     }
   }
   return std::move(ideal.maps);
@@ -53,6 +56,17 @@ std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const Sh
   compute::IdealMaps ideal;
   backend.fitIdealMaps(space.faces(), space.basePositions(), normalizedTarget, kind == IdealMapKind::Similar, ideal);
   return checkedMaps(std::move(ideal), fallbacks);
+}
+
+compute::DeviceMatrix fittedIdealMapsOnDevice(compute::Backend& backend, const ShapeSpace& space,
+                                              const Positions& target, IdealMapKind kind, Index* fallbacks) {
+  const Positions normalizedTarget = normalizedTargetPositions(space, target);
+  compute::DeviceIdealMaps ideal;
+  backend.fitIdealMapsOnDevice(space.faces(), space.basePositions(), normalizedTarget,
+                               kind == IdealMapKind::Similar, ideal);
+  if (ideal.centroidsAtInfinity > 0) throwCentroidAtInfinity(ideal.firstCentroidAtInfinity);
+  if (fallbacks) *fallbacks = ideal.cornerProcrustes;
+  return std::move(ideal.linearColumns);
 }
 
 }  // namespace plano::projective

@@ -54,4 +54,10 @@ std::vector<Eigen::Matrix4d> closestIdealMaps(compute::Backend& backend, const S
 std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const ShapeSpace& space,
                                              const Positions& target, IdealMapKind kind, Index* fallbacks = nullptr);
 
+/// fittedIdealMaps with the maps left where the backend computed them
+/// (Backend::fitIdealMapsOnDevice): their first three columns, 4 #F x 3 (GlobalStep::
+/// solveAffine's targets; fourth columns (0, 0, 0, 1)). The same checks and errors.
+compute::DeviceMatrix fittedIdealMapsOnDevice(compute::Backend& backend, const ShapeSpace& space,
+                                              const Positions& target, IdealMapKind kind, Index* fallbacks = nullptr);
+
 }  // namespace plano::projective

@@ -1020,13 +1020,13 @@ class RecordingKernels final : public compute::AdmmKernels {
   void setConstraintValues(const compute::SparseMatrix& C) override { inner_->setConstraintValues(C); }
   void setConstraintScaling(const compute::ConstraintScaling& scaling) override { inner_->setConstraintScaling(scaling); }
   void setConstraintScales(std::span<const double> scales) override { inner_->setConstraintScales(scales); }
-  void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
+  void start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override {
     if (record_.q.size() == 0) {
-      record_.q = q;
+      record_.q = q.values();
       record_.lower = lower;
       record_.upper = upper;
-      record_.x = x;
+      record_.x = x.size() > 0 ? x.values() : Eigen::MatrixXd();
       record_.y = y;
     }
     inner_->start(q, lower, upper, x, y);

@@ -60,15 +60,6 @@ Fitted fit(const PolygonMesh& mesh, const Positions& target) {
   return out;
 }
 
-Positions rotatedScaledAndPerturbed(const Positions& x, double scale, double noise, unsigned seed) {
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, 1.0, -0.5).normalized()).toRotationMatrix();
-  Positions out = ((scale * x * R).rowwise() + Eigen::RowVector3d(0.3, -0.7, 1.1)).eval();
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal(0.0, noise);
-  for (Eigen::Index i = 0; i < out.size(); ++i) out.data()[i] += normal(rng);
-  return out;
-}
-
 class VulkanIdealMaps : public VulkanTest {};
 
 TEST_F(VulkanIdealMaps, AgreeWithTheCpuOnPerspectiveFitsOfHexagonsRigidAndSimilar) {
@@ -259,6 +250,99 @@ TEST_F(VulkanIdealMaps, AGlobalStepOnTheIdealMapsJustComputedFormsItsLinearTermF
   // Bit for bit the same step.
   ASSERT_EQ(formed.maps.size(), uploaded.maps.size());
   for (std::size_t f = 0; f < formed.maps.size(); ++f) EXPECT_EQ(formed.maps[f], uploaded.maps[f]) << "face " << f;
+}
+
+TEST_F(VulkanIdealMaps, MapsKeptOnTheDeviceAgreeWithTheCpuAndOnlyTheirTalliesComeBack) {
+  const PolygonMesh mesh = generate::hexagonalDome(2);  // hexagons: some corner-set fallbacks
+  const projective::ShapeSpace space(mesh);
+  const auto faces = static_cast<std::uint64_t>(mesh.faces.size());
+  for (const unsigned seed : {21u, 22u}) {
+    const Positions target =
+        space.normalization().toNormalized(rotatedScaledAndPerturbed(mesh.vertices, 1.2, 0.05, seed));
+    for (const bool similar : {false, true}) {
+      compute::IdealMaps cpu;
+      compute::CpuBackend().fitIdealMaps(mesh.faces, space.basePositions(), target, similar, cpu);
+      compute::DeviceIdealMaps warm;  // the base mesh and topology reach the device once
+      backend().fitIdealMapsOnDevice(mesh.faces, space.basePositions(), space.basePositions(), similar, warm);
+      const vk::TransferCounts before = context().transfers();
+      compute::DeviceIdealMaps kept;
+      backend().fitIdealMapsOnDevice(mesh.faces, space.basePositions(), target, similar, kept);
+      const vk::TransferCounts after = context().transfers();
+      // Up: the target positions; down: three tallies, no map.
+      EXPECT_EQ(after.uploadedBytes - before.uploadedBytes, static_cast<std::uint64_t>(target.size()) * 8u);
+      EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, 12u);
+      EXPECT_FALSE(kept.linearColumns.onHost());
+
+      Index procrustes = 0;
+      for (const auto method : cpu.methods) procrustes += method == compute::IdealMapMethod::CornerProcrustes;
+      EXPECT_EQ(kept.cornerProcrustes, procrustes);
+      EXPECT_EQ(kept.centroidsAtInfinity, 0);
+      EXPECT_EQ(kept.firstCentroidAtInfinity, -1);
+
+      const Eigen::MatrixXd& columns = kept.linearColumns.values();  // the one download of the maps
+      EXPECT_EQ(context().transfers().downloadedBytes - after.downloadedBytes, faces * 128u);
+      ASSERT_EQ(columns.rows(), static_cast<Eigen::Index>(4 * faces));
+      double largest = 0.0;
+      for (Index f = 0; f < mesh.faces.size(); ++f) {
+        largest = std::max(largest, (columns.middleRows<4>(4 * f) - cpu.maps[f].leftCols<3>()).cwiseAbs().maxCoeff());
+        EXPECT_EQ(cpu.maps[f].col(3), Eigen::Vector4d(0.0, 0.0, 0.0, 1.0));  // affine: nothing to keep there
+      }
+      EXPECT_LT(largest, 1e-10) << "seed " << seed << ", similar " << similar;
+      EXPECT_EQ(kept.linearColumns.negated().values(), -columns);  // shares the copy: no download
+    }
+  }
+}
+
+TEST_F(VulkanIdealMaps, KeptMapsCannotBeReadOnceTheDeviceHasRewrittenThem) {
+  const PolygonMesh mesh = generate::translationalSurface(4, 4);
+  const projective::ShapeSpace space(mesh);
+  const Positions first = rotatedScaledAndPerturbed(space.basePositions(), 1.0, 0.01, 1);
+  const Positions second = rotatedScaledAndPerturbed(space.basePositions(), 1.0, 0.01, 2);
+  compute::DeviceIdealMaps a, b;
+  backend().fitIdealMapsOnDevice(mesh.faces, space.basePositions(), first, false, a);
+  backend().fitIdealMapsOnDevice(mesh.faces, space.basePositions(), second, false, b);
+  try {
+    (void)a.linearColumns.values();
+    ADD_FAILURE() << "expected Error(Usage)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage) << e.what();
+  }
+  EXPECT_EQ(b.linearColumns.values().rows(), static_cast<Eigen::Index>(4 * mesh.faces.size()));  // the latest are still there
+  // The CPU keeps its maps on the host.
+  compute::DeviceIdealMaps host;
+  compute::CpuBackend().fitIdealMapsOnDevice(mesh.faces, space.basePositions(), first, false, host);
+  EXPECT_TRUE(host.linearColumns.onHost());
+}
+
+TEST_F(VulkanIdealMaps, AnAffineGlobalStepOnKeptMapsUploadsNoTargetsAndIsTheStepOnTheirValues) {
+  const PolygonMesh mesh = generate::translationalSurface(4, 4);
+  const projective::ShapeSpace space(mesh);
+  std::vector<Index> fixed;
+  for (Index v = 0; v <= 4; ++v) fixed.push_back(v);
+  Positions at(fixed.size(), 3);
+  for (std::size_t i = 0; i < fixed.size(); ++i) at.row(i) = mesh.vertices.row(fixed[i]);
+  const Positions target = rotatedScaledAndPerturbed(mesh.vertices, 1.0, 0.02, 12);
+
+  // The step on the kept maps, and a step of a solver of its own on their values, uploaded.
+  const compute::DeviceMatrix kept =
+      projective::fittedIdealMapsOnDevice(backend(), space, target, projective::IdealMapKind::Rigid);
+  projective::FaceMaps onDevice, fromHost;
+  vk::TransferCounts before = context().transfers();
+  const projective::GlobalStepInfo a = projective::GlobalStep(backend(), space, fixed).solveAffine(kept, at, onDevice);
+  const std::uint64_t keptUploads = context().transfers().uploadedBytes - before.uploadedBytes;
+  EXPECT_FALSE(kept.onHost());  // nothing read the maps on the host
+  const Eigen::MatrixXd values = kept.values();
+  before = context().transfers();
+  const projective::GlobalStepInfo b = projective::GlobalStep(backend(), space, fixed).solveAffine(values, at, fromHost);
+  const vk::TransferCounts afterValues = context().transfers();
+  EXPECT_GT(a.admmIterations, 0);
+  const auto qBytes = static_cast<std::uint64_t>(values.size()) * sizeof(double);
+  // The values' step uploads q (its x = -q is formed on the device either way).
+  EXPECT_EQ((afterValues.uploadedBytes - before.uploadedBytes) - keptUploads, qBytes);
+  EXPECT_EQ(a.initialViolation, b.initialViolation);
+  EXPECT_EQ(a.admmIterations, b.admmIterations);
+  ASSERT_EQ(onDevice.maps.size(), fromHost.maps.size());
+  for (std::size_t f = 0; f < onDevice.maps.size(); ++f) EXPECT_EQ(onDevice.maps[f], fromHost.maps[f]) << "face " << f;
 }
 
 TEST_F(VulkanIdealMaps, TheFusedLocalStepOfATargetOfOtherSizeIsAUsageErrorOnBothBackends) {

@@ -10,6 +10,7 @@
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
+#include "projective/IdealMaps.h"
 #include "projective/LocalStep.h"
 #include "projective/ProjectiveTestHelpers.h"
 #include "support/TestMeshes.h"
@@ -244,6 +245,50 @@ TEST_F(GlobalStepTest, CornerAtInfinityIsANumericalError) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Numerical);
     EXPECT_NE(std::string(e.what()).find("vertex 0"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(GlobalStepTest, AffineTargetsByTheirColumnsGiveTheSameStepAsTheMaps) {
+  // Ideal maps of a perturbed rigid motion (affine), with fixed vertices: an ε schedule
+  // with ADMM attempts, then the direct solve.
+  const PolygonMesh mesh = generate::translationalSurface(6, 5);
+  const ShapeSpace space(mesh);
+  std::vector<Index> fixed;
+  Positions at(7, 3);
+  for (Index v = 0; v < 7; ++v) {
+    fixed.push_back(v);
+    at.row(v) = mesh.vertices.row(v);
+  }
+  const Positions target = test::rotatedScaledAndPerturbed(mesh.vertices, 1.0, 0.03, 4);
+  const auto ideal = fittedIdealMaps(backend, space, target, IdealMapKind::Rigid);
+  Eigen::MatrixXd columns(4 * space.faceCount(), 3);
+  for (Index f = 0; f < space.faceCount(); ++f) columns.middleRows<4>(4 * f) = ideal[f].leftCols<3>();
+
+  FaceMaps byMaps, byColumns;
+  const GlobalStepInfo a = GlobalStep(backend, space, fixed).solve(ideal, at, byMaps);
+  const GlobalStepInfo b = GlobalStep(backend, space, fixed).solveAffine(columns, at, byColumns);
+  EXPECT_GT(a.admmIterations + a.polishRefinements, 0);  // not a trivial step
+  EXPECT_EQ(a.initialViolation, b.initialViolation);
+  EXPECT_EQ(a.epsilon, b.epsilon);
+  EXPECT_EQ(a.admmIterations, b.admmIterations);
+  ASSERT_EQ(byMaps.maps.size(), byColumns.maps.size());
+  for (std::size_t f = 0; f < byMaps.maps.size(); ++f) EXPECT_EQ(byMaps.maps[f], byColumns.maps[f]) << "face " << f;
+  EXPECT_EQ(byMaps.reciprocalScales, byColumns.reciprocalScales);
+
+  // A non-finite target names its face; columns of the wrong size are a usage error.
+  columns(4 * 3 + 1, 2) = std::nan("");
+  try {
+    GlobalStep(backend, space, fixed).solveAffine(columns, at, byColumns);
+    ADD_FAILURE() << "expected Error(Numerical)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("face 3 "), std::string::npos) << e.what();
+  }
+  try {
+    GlobalStep(backend, space, fixed).solveAffine(Eigen::MatrixXd::Zero(8, 3), at, byColumns);
+    ADD_FAILURE() << "expected Error(Usage)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
   }
 }
 

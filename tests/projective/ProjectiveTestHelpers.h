@@ -1,6 +1,8 @@
 #pragma once
 // Helpers shared by the projective tests: projective images of point sets and meshes.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <random>
 #include <vector>
 
 #include "mesh/PolygonMesh.h"
@@ -27,6 +29,17 @@ inline Eigen::Matrix4d samplePerspective() {
       0.1, -0.05, 0.95, 0.1,  //
       0.3, -0.2, 0.4, 1.0;
   return H;
+}
+
+/// A rigid motion of `x` scaled by `scale`, each coordinate then perturbed by normal noise
+/// of deviation `noise` (seeded): targets whose ideal maps differ face to face.
+inline Positions rotatedScaledAndPerturbed(const Positions& x, double scale, double noise, unsigned seed) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, 1.0, -0.5).normalized()).toRotationMatrix();
+  Positions out = ((scale * x * R).rowwise() + Eigen::RowVector3d(0.3, -0.7, 1.1)).eval();
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, noise);
+  for (Eigen::Index i = 0; i < out.size(); ++i) out.data()[i] += normal(rng);
+  return out;
 }
 
 }  // namespace plano::test

@@ -290,6 +290,8 @@ struct AdmmKernels::Workspace {
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
   Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
+  /// The resident maps' generation whose -T w.q holds (0: none; uploadedQ is then what it holds).
+  std::uint64_t residentQGeneration = 0;
   Eigen::MatrixXd uploadedCentre;         ///< What w.centre holds (skipped likewise).
   std::vector<std::uint32_t> heldSides;   ///< What w.sides holds (empty: nothing known).
   std::unique_ptr<Sequence> findSides, measureViolation;
@@ -795,25 +797,37 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   });
 }
 
-bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
+bool AdmmKernels::loadLinearTerm(const compute::DeviceMatrix& q) {
   const auto k = elementCount(q.cols(), "the ADMM's column count");
   if (k == 0) {  // nothing to iterate; measure() reports empty norms
     workspace_.reset();
     return false;
   }
+  if (q.rows() != static_cast<Eigen::Index>(n_)) throwUsage("Vulkan ADMM: q must have n rows");
   prepare(k);
   Workspace& w = *workspace_;
-  // The attempts of one global step's ε schedule solve with one q (only the bounds widen):
-  // the device keeps it (nothing else writes w.q).
-  if (w.uploadedQ.rows() == q.rows() && w.uploadedQ.cols() == q.cols() && w.uploadedQ == q) return true;
-  // A global step's q = -T of the ideal maps the backend's kernel just computed: formed
-  // from them where they are, bit for bit the host's.
-  const Array<double>* maps = residentMaps_ ? residentMaps_->holdingNegatedColumns(q) : nullptr;
-  if (!maps) {
-    uploadIfChanged(w.q, w.uploadedQ, q);
-    return true;
+  // A global step's q = -T of the ideal maps the backend's kernel just computed, left on the
+  // device (a DeviceMatrix of theirs) or downloaded (host values equal to them): formed from
+  // them where they are, bit for bit the host's.
+  const Array<double>* maps = residentMaps_ ? residentMaps_->holdingColumns(q, -1.0) : nullptr;
+  if (maps) {
+    // The attempts of one global step's ε schedule solve with one q (only the bounds widen).
+    if (w.residentQGeneration == residentMaps_->generation()) return true;
+  } else {
+    const Eigen::MatrixXd& values = q.values();
+    if (w.residentQGeneration == 0 && w.uploadedQ.rows() == values.rows() && w.uploadedQ.cols() == values.cols() &&
+        w.uploadedQ == values) {
+      return true;
+    }
+    maps = residentMaps_ ? residentMaps_->holdingNegatedColumns(values) : nullptr;
+    if (!maps) {
+      w.residentQGeneration = 0;
+      uploadIfChanged(w.q, w.uploadedQ, values);
+      return true;
+    }
   }
   w.uploadedQ.resize(0, 0);  // a run that throws leaves nothing claimed
+  w.residentQGeneration = 0;
   const auto faceCount = static_cast<std::uint32_t>(q.rows() / 4);
   Sequence s(context_);
   s.begin();
@@ -822,23 +836,25 @@ bool AdmmKernels::loadLinearTerm(const Eigen::MatrixXd& q) {
              NegatedMapsPush{faceCount, k}, groupsFor(context_, static_cast<std::size_t>(n_) * k));
   s.end();
   s.run();
-  w.uploadedQ = q;
+  if (q.onHost()) {
+    w.uploadedQ = q.values();
+  } else {
+    w.residentQGeneration = residentMaps_->generation();
+  }
   return true;
 }
 
-void AdmmKernels::start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                        const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
+void AdmmKernels::start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                        const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) {
   if (!loadLinearTerm(q)) return;
   workspace_->lower.upload(lower);
   workspace_->upper.upload(upper);
   finishStart(q, x, y, false, 0.0);
 }
 
-void AdmmKernels::startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds,
-                               const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
-  if (!loadLinearTerm(q)) return;
+void AdmmKernels::loadRelaxedBounds(const compute::RelaxedBounds& bounds) {
   Workspace& w = *workspace_;
-  if (bounds.centre.rows() != m_ || bounds.centre.cols() != q.cols() || bounds.relaxed.size() != m_) {
+  if (bounds.centre.rows() != m_ || bounds.centre.cols() != w.k || bounds.relaxed.size() != m_) {
     throwUsage("Vulkan ADMM: relaxed bounds need an m x k centre and one flag per row");
   }
   // An ε schedule's attempts share the centre and the flags, a loop's steps the flags.
@@ -849,20 +865,38 @@ void AdmmKernels::startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedB
     w.relaxed.upload(flags);
     w.uploadedRelaxed = bounds.relaxed;
   }
+}
+
+void AdmmKernels::startRelaxed(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                               const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) {
+  if (!loadLinearTerm(q)) return;
+  loadRelaxedBounds(bounds);
   finishStart(q, x, y, true, bounds.epsilon);
 }
 
-void AdmmKernels::finishStart(const Eigen::MatrixXd& q, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+std::optional<double> AdmmKernels::violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                                               const compute::DeviceMatrix& x) {
+  if (!loadLinearTerm(q)) return 0.0;
+  loadRelaxedBounds(bounds);
+  finishStart(q, x, Eigen::MatrixXd(), true, 0.0);  // l = u = the centre
+  return boundViolation();
+}
+
+void AdmmKernels::finishStart(const compute::DeviceMatrix& q, const compute::DeviceMatrix& x, const Eigen::MatrixXd& y,
                               bool relaxedBounds, double epsilon) {
   Workspace& w = *workspace_;
   StartX xStart = StartX::Uploaded;
   if (x.size() == 0) {
     xStart = StartX::Zero;
-  } else if (x.rows() == q.rows() && x.cols() == q.cols() && x == -q) {  // exact: negation rounds nothing
+  } else if (x.rows() == q.rows() && x.cols() == q.cols() && x.source() && x.source() == q.source() &&
+             x.factor() == -q.factor()) {  // one device matrix and its negation
+    xStart = StartX::NegatedQ;
+  } else if (x.onHost() && q.onHost() && x.rows() == q.rows() && x.cols() == q.cols() &&
+             x.values() == -q.values()) {  // exact: negation rounds nothing
     xStart = StartX::NegatedQ;
   }
   const bool zeroY = y.size() == 0;
-  if (xStart == StartX::Uploaded) w.x.upload(x);
+  if (xStart == StartX::Uploaded) w.x.upload(x.values());
   if (!zeroY) w.y.upload(y);
   double state[kStateSize] = {};
   state[kStateEpsilon] = epsilon;

@@ -124,10 +124,15 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// (shaders/admm_relaxed_bounds.comp), and so are warm starts that are empty (zero) or,
   /// for x, equal to -q (the global step's: its targets): an ε schedule's later attempts
   /// then upload nothing mesh-sized.
-  void start(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override;
-  void startRelaxed(const Eigen::MatrixXd& q, const compute::RelaxedBounds& bounds, const Eigen::MatrixXd& x,
-                    const Eigen::MatrixXd& y) override;
+  /// A q that is minus a device matrix of the backend's resident ideal maps, and an x that is
+  /// that matrix, are formed from the maps' array (no copy either way).
+  void start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override;
+  void startRelaxed(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                    const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override;
+  /// startRelaxed with epsilon 0, then boundViolation(): one check-sized read.
+  std::optional<double> violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                                    const compute::DeviceMatrix& x) override;
   void iterate(int count) override;
   compute::AdmmMeasures measure() override;
   void setLinearTolerance(double tolerance) override;
@@ -163,11 +168,14 @@ class AdmmKernels final : public compute::AdmmKernels {
   enum class StartX { Uploaded, Zero, NegatedQ };
   /// Both starts' first part: the workspace for q's columns, and q (false: no columns,
   /// nothing to start).
-  bool loadLinearTerm(const Eigen::MatrixXd& q);
+  bool loadLinearTerm(const compute::DeviceMatrix& q);
+  /// A relaxation's centre and flags, each uploaded only when it changed (Error(Usage) for
+  /// the wrong sizes).
+  void loadRelaxedBounds(const compute::RelaxedBounds& bounds);
   /// Both starts' last part, after the bounds: the warm starts (uploaded or formed as StartX
   /// says), the state (with a relaxation's epsilon) and the start recording.
-  void finishStart(const Eigen::MatrixXd& q, const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, bool relaxedBounds,
-                   double epsilon);
+  void finishStart(const compute::DeviceMatrix& q, const compute::DeviceMatrix& x, const Eigen::MatrixXd& y,
+                   bool relaxedBounds, double epsilon);
   /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after setting x (StartX), zeroing y
   /// and forming relaxed bounds as asked.
   void recordStart(Sequence& s, StartX xStart, bool zeroY, bool relaxedBounds);

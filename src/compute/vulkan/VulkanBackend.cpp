@@ -68,6 +68,20 @@ void VulkanBackend::fitIdealMaps(const FaceList& faces, const Positions& source,
   idealMaps_->runOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
 }
 
+void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+                                         bool similar, DeviceIdealMaps& out) {
+  if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  const bool oneBinding = faceCount <= context_->info().maxStorageBufferRange / (16 * sizeof(double));
+  const vk::Array<double>* fits = oneBinding ? projectiveFit_->runResident(faces, source, target) : nullptr;
+  if (!fits) {  // no faces, or more maps than one binding holds: the host keeps them
+    Backend::fitIdealMapsOnDevice(faces, source, target, similar, out);
+    return;
+  }
+  if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_, residentMaps_.get());
+  idealMaps_->keepOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
+}
+
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {
   return std::make_unique<vk::PcgSolver>(*context_, A, settings);
 }

@@ -40,6 +40,10 @@ class VulkanBackend final : public Backend {
   /// The fits stay on the device: only the ideal maps come back.
   void fitIdealMaps(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
                     IdealMaps& out) override;
+  /// The fits and the ideal maps stay on the device (vk::ResidentFaceMaps): three tallies
+  /// come back, and the maps only when their values are read.
+  void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+                            DeviceIdealMaps& out) override;
   /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;

@@ -23,13 +23,71 @@ constexpr std::size_t kMapBytes = 16 * sizeof(double);
 
 }  // namespace
 
+class ResidentFaceMaps::ColumnsSource final : public compute::DeviceMatrixSource {
+ public:
+  ColumnsSource(const ResidentFaceMaps& record)
+      : array_(record.array_),
+        faceCount_(record.faceCount_),
+        generation_(record.generation_),
+        live_(record.liveGeneration_) {}
+
+  void fetch(Eigen::MatrixXd& out) const override {
+    const auto live = live_.lock();
+    if (!live || *live != generation_) {
+      throwUsage("ideal maps on the device: they were overwritten (or the backend destroyed) before they were read");
+    }
+    std::vector<Eigen::Matrix4d> maps(faceCount_);
+    array_->Buffer::download(maps.data(), faceCount_ * kMapBytes);
+    out.resize(4 * static_cast<Eigen::Index>(faceCount_), 3);
+    for (std::size_t f = 0; f < faceCount_; ++f) out.middleRows<4>(4 * static_cast<Eigen::Index>(f)) = maps[f].leftCols<3>();
+  }
+
+  bool holds(const ResidentFaceMaps& record) const { return record.array_ && record.generation_ == generation_; }
+
+ private:
+  const Array<double>* array_;
+  std::size_t faceCount_;
+  std::uint64_t generation_;
+  std::weak_ptr<const std::uint64_t> live_;
+};
+
+void ResidentFaceMaps::hold(const Array<double>& array, std::size_t faceCount, std::vector<Eigen::Matrix4d> maps) {
+  array_ = &array;
+  faceCount_ = faceCount;
+  maps_ = std::move(maps);
+  *liveGeneration_ = ++generation_;
+  source_.reset();
+}
+
+void ResidentFaceMaps::release() {
+  array_ = nullptr;
+  faceCount_ = 0;
+  maps_.clear();
+  *liveGeneration_ = ++generation_;
+  source_.reset();
+}
+
 const Array<double>* ResidentFaceMaps::holdingNegatedColumns(const Eigen::MatrixXd& q) const {
-  if (!array_ || q.cols() > 4 || q.rows() != 4 * static_cast<Eigen::Index>(maps_.size())) return nullptr;
+  if (!array_ || q.cols() > 4 || maps_.size() != faceCount_ || q.rows() != 4 * static_cast<Eigen::Index>(maps_.size())) {
+    return nullptr;
+  }
   for (std::size_t f = 0; f < maps_.size(); ++f) {
     const auto row = static_cast<Eigen::Index>(4 * f);
     if (q.middleRows<4>(row) != -maps_[f].leftCols(q.cols())) return nullptr;  // exact: negation rounds nothing
   }
   return array_;
+}
+
+const Array<double>* ResidentFaceMaps::holdingColumns(const compute::DeviceMatrix& m, double factor) const {
+  if (!array_ || !source_ || m.source() != source_.get() || m.factor() != factor) return nullptr;
+  if (m.rows() != 4 * static_cast<Eigen::Index>(faceCount_) || m.cols() != 3 || !source_->holds(*this)) return nullptr;
+  return array_;
+}
+
+std::shared_ptr<const compute::DeviceMatrixSource> ResidentFaceMaps::columnsSource() const {
+  if (!array_) throwUsage("ideal maps on the device: none are held");
+  if (!source_) source_ = std::make_shared<const ColumnsSource>(*this);
+  return source_;
 }
 
 IdealMapsKernel::IdealMapsKernel(Context& context, ResidentFaceMaps* resident)
@@ -61,11 +119,13 @@ void IdealMapsKernel::runOnResidentFits(const FaceList& faces, const Positions& 
 
 void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                               const Positions* target, bool similar, compute::IdealMaps& out,
-                              const Array<double>* residentFitted, const Array<double>* residentTarget) {
+                              const Array<double>* residentFitted, const Array<double>* residentTarget,
+                              compute::DeviceIdealMaps* kept) {
   if (resident_) resident_->release();  // ideal_ changes (or is reallocated) below
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
-  out.maps.resize(faceCount);
-  out.methods.resize(faceCount);
+  out.maps.resize(kept ? 0 : faceCount);
+  out.methods.resize(kept ? 0 : faceCount);
+  if (kept) *kept = compute::DeviceIdealMaps{};
   if (faceCount == 0) return;
   checkFaces(faces, static_cast<Index>(source.rows()), "closestIdealMaps");
 
@@ -97,21 +157,58 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
                      BufferRange(fittedArray, 0, chunk * kMapBytes), BufferRange(ideal_, 0, chunk * kMapBytes),
                      BufferRange(methods_, 0, chunk * sizeof(std::int32_t))});
+  if (kept && (chunk < faceCount || !resident_)) {
+    throwUsage("closestIdealMaps: the ideal maps of " + std::to_string(faceCount) +
+               " faces cannot stay on the device (more than one binding, or no record of them)");
+  }
+  if (kept) {
+    if (!tally_) tally_ = std::make_unique<Pipeline>(context_, "ideal_map_tally", 2, sizeof(std::uint32_t));
+    ensureCapacity(tallies_, context_, 3, "ideal map tallies");
+  }
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount; first += chunk) {
     const std::size_t n = std::min(chunk, faceCount - first);
     if (!residentFitted) fitted_.Buffer::upload(fitted.data() + first, n * kMapBytes);
     sequence.begin();
+    if (kept) sequence.zero(tallies_, 3 * sizeof(std::uint32_t));
     sequence.dispatch(pipeline_, set,
                       IdealMapsPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), target ? 1u : 0u,
                            similar ? 1u : 0u},
                       groupsFor(context_, n));
+    if (kept) {
+      sequence.barrier();
+      const auto count = static_cast<std::uint32_t>(n);
+      sequence.dispatch(*tally_, {BufferRange(methods_, 0, n * sizeof(std::int32_t)), BufferRange(tallies_)}, count,
+                        groupsFor(context_, n));
+    }
     sequence.end();
     sequence.run();
+    if (kept) break;  // one chunk
     ideal_.Buffer::download(out.maps.data() + first, n * kMapBytes);
     methods_.Buffer::download(out.methods.data() + first, n * sizeof(std::int32_t));
   }
-  if (resident_ && chunk == faceCount) resident_->hold(ideal_, out.maps);  // ideal_ holds them all
+  if (!resident_ || chunk < faceCount) return;
+  resident_->hold(ideal_, faceCount, kept ? std::vector<Eigen::Matrix4d>{} : out.maps);  // ideal_ holds them all
+  if (!kept) return;
+  std::uint32_t tally[3] = {};
+  tallies_.download({tally, 3});
+  kept->cornerProcrustes = static_cast<Index>(tally[0]);
+  kept->centroidsAtInfinity = static_cast<Index>(tally[1]);
+  kept->firstCentroidAtInfinity = tally[1] > 0 ? static_cast<Index>(0xffffffffu - tally[2]) : -1;
+  kept->linearColumns = compute::DeviceMatrix(4 * static_cast<Eigen::Index>(faceCount), 3, resident_->columnsSource());
+}
+
+void IdealMapsKernel::keepOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
+                                         const Positions& target, const Array<double>* residentTarget, bool similar,
+                                         compute::DeviceIdealMaps& out) {
+  compute::checkFitInputs(source, target);
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  if (fitted.count() < faceCount * 16 || faceCount > context_.info().maxStorageBufferRange / kMapBytes) {
+    throwUsage("closestIdealMaps: the resident fits do not hold the maps of all " + std::to_string(faceCount) +
+               " faces in one binding");
+  }
+  compute::IdealMaps unused;
+  mapChunks(faces, source, {}, &target, similar, unused, &fitted, residentTarget, &out);
 }
 
 }  // namespace plano::vk

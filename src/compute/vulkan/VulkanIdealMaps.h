@@ -3,35 +3,50 @@
 // shaders/ideal_maps.comp, the math of src/projective/IdealMapFit.cpp (the fit's in-plane
 // Jacobian, its closest rotation by a one-sided Jacobi SVD, the corner-set fallback), one
 // invocation per face, fp64.
+#include <memory>
+
 #include "compute/Backend.h"
 #include "compute/vulkan/VulkanSequence.h"
 
 namespace plano::vk {
 
 /// The face maps (16 doubles a face, column-major) that the ideal-map kernel left in its
-/// device array, with the host copy of what that array holds. The backend hands one record
-/// to that kernel, which keeps it current, and to the ADMM kernels: a global step's linear
-/// term q = -T of exactly those maps (its targets) is then formed from the array on the
-/// device instead of uploaded (vk::AdmmKernels::start). The host copy costs 128 B a face,
-/// as the fit kernel's of its maps (exact comparison needs the values, not a digest).
+/// device array. The backend hands one record to that kernel, which keeps it current, and to
+/// the ADMM kernels: a global step's linear term q = -T of exactly those maps (its targets)
+/// and its warm start x = T are then formed from the array on the device instead of
+/// uploaded (vk::AdmmKernels::start). Two ways to say "exactly those maps":
+///  - a DeviceMatrix whose source is this record's columnsSource() of the current
+///    generation (a loop that never fetched the maps: nothing mesh-sized crossed);
+///  - host values equal to the host copy the kernel gave when it also downloaded the maps
+///    (128 B a face, as exact comparison needs the values, not a digest).
 class ResidentFaceMaps {
  public:
-  /// `array` holds `maps` now (until the next hold or release).
-  void hold(const Array<double>& array, std::vector<Eigen::Matrix4d> maps) {
-    array_ = &array;
-    maps_ = std::move(maps);
-  }
-  void release() {
-    array_ = nullptr;
-    maps_.clear();
-  }
+  /// `array` holds the maps of `faceCount` faces now (until the next hold or release);
+  /// `maps` is their host copy, or empty when they were not downloaded.
+  void hold(const Array<double>& array, std::size_t faceCount, std::vector<Eigen::Matrix4d> maps);
+  void release();
   /// The array when `q` (n x k, k <= 4) is, entry for entry, minus the first k columns of
   /// the held maps stacked four rows a face (q(4 f + r, c) = -M_f(r, c)); else null.
   const Array<double>* holdingNegatedColumns(const Eigen::MatrixXd& q) const;
+  /// The array when `m` is `factor` times columnsSource()'s matrix of the maps held now.
+  const Array<double>* holdingColumns(const compute::DeviceMatrix& m, double factor) const;
+  /// The held maps' first three columns (4 #F x 3) as a device matrix's source: fetched
+  /// from the array while this record holds them (Error(Usage) after).
+  std::shared_ptr<const compute::DeviceMatrixSource> columnsSource() const;
+  std::uint64_t generation() const { return generation_; }
 
  private:
+  class ColumnsSource;
   const Array<double>* array_ = nullptr;
+  std::size_t faceCount_ = 0;
   std::vector<Eigen::Matrix4d> maps_;
+  std::uint64_t generation_ = 0;  ///< Changes with every hold and release.
+  /// The source of the current generation (made on first request; one per generation, so
+  /// that q = -T and x = T of one step share it).
+  mutable std::shared_ptr<const ColumnsSource> source_;
+  /// generation_, watched by the sources (weakly: a source may outlive this record), which
+  /// read the array only while it still says their generation.
+  std::shared_ptr<std::uint64_t> liveGeneration_ = std::make_shared<std::uint64_t>(0);
 };
 
 class IdealMapsKernel {
@@ -60,16 +75,26 @@ class IdealMapsKernel {
   void runOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
                          const Positions& target, const Array<double>* residentTarget, bool similar,
                          compute::IdealMaps& out);
+  /// runOnResidentFits that leaves the maps on the device (compute::Backend::
+  /// fitIdealMapsOnDevice): only the methods' tallies (shaders/ideal_map_tally.comp, 12
+  /// bytes) come back. Needs the kernel's resident record (Error(Usage) without one).
+  void keepOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
+                          const Positions& target, const Array<double>* residentTarget, bool similar,
+                          compute::DeviceIdealMaps& out);
 
  private:
-  /// Both runs, after their input checks: `fitted` is read only without `residentFitted`.
+  /// The runs, after their input checks: `fitted` is read only without `residentFitted`.
+  /// With `kept` (one chunk, a resident record), nothing but the tallies is downloaded and
+  /// `out` is left empty.
   void mapChunks(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
                const Positions* target, bool similar, compute::IdealMaps& out, const Array<double>* residentFitted,
-               const Array<double>* residentTarget);
+               const Array<double>* residentTarget, compute::DeviceIdealMaps* kept = nullptr);
 
   Context& context_;
   ResidentFaceMaps* resident_;
   Pipeline pipeline_;
+  std::unique_ptr<Pipeline> tally_;  ///< Made by the first kept run.
+  Array<std::uint32_t> tallies_;
   // Reused across calls (grow-only): a deformation loop allocates once and uploads its
   // source and topology once.
   CachedArray<double> source_;
