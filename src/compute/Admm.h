@@ -268,6 +268,18 @@ class AdmmKernels {
   /// max(l - C x, C x - u, 0) over all rows and columns at the current x; NaN (or +Inf)
   /// when C x is not finite.
   virtual double boundViolation();
+  /// The current x (n x k) as a device matrix whose values stay where the kernels keep the
+  /// iterate (a copy there, readable until the next solution() of these kernels: Error(Usage)
+  /// after), or nullopt for kernels that do not keep it there (the caller downloads x).
+  virtual std::optional<DeviceMatrix> solution() { return std::nullopt; }
+  /// After a relaxed start (startRelaxed): max |C x - centre| at the current x over all rows
+  /// (`relaxedRows`) or over the rows not relaxed only, measured where the kernels keep the
+  /// iterate; the bounds are formed again for the next check. nullopt for kernels that do not
+  /// keep the iterate there, or after a start that was not relaxed. NaN when C x is not finite.
+  virtual std::optional<double> centreDistance(bool relaxedRows) {
+    (void)relaxedRows;
+    return std::nullopt;
+  }
   /// Start (as startRelaxed, y zero) with bounds.centre as both bounds, and return
   /// boundViolation(): max |C x - centre|, measured where the kernels keep the iterate.
   /// nullopt (nothing started) for kernels that do not keep it there.
@@ -306,6 +318,9 @@ class AdmmSolver {
   double violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
                      const SparseMatrix& C);
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) { kernels_->download(x, y, z); }
+  /// AdmmKernels::solution and centreDistance on the last solve's iterate.
+  std::optional<DeviceMatrix> solution() { return kernels_->solution(); }
+  std::optional<double> centreDistance(bool relaxedRows) { return kernels_->centreDistance(relaxedRows); }
   void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) { kernels_->downloadSolution(x, y); }
 
   /// The same with the bounds as a relaxation (RelaxedBounds: centre m x k, one flag per

@@ -112,6 +112,31 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const compute::Rela
   return info;
 }
 
+BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                             const compute::DeviceMatrix& start, compute::DeviceMatrix& x) {
+  Eigen::MatrixXd hostX, y;
+  const BoxQpInfo info = solve(q, bounds.lower(), bounds.upper(), &bounds, &start, hostX, y, &x);
+  return info;
+}
+
+double BoxQpSolver::centreDistance(const compute::DeviceMatrix& x, const compute::RelaxedBounds& bounds,
+                                   bool relaxedRows) {
+  if (!x.onHost()) {
+    if (const auto measured = admm_->centreDistance(relaxedRows)) return *measured;
+  }
+  const Eigen::Index m = C_.rows();
+  if (m == 0 || x.cols() == 0) return 0.0;
+  const Eigen::MatrixXd distance = (C_ * x.values() - bounds.centre).cwiseAbs();
+  double largest = 0.0;
+  for (Eigen::Index r = 0; r < m; ++r) {
+    if (!relaxedRows && bounds.relaxed[static_cast<std::size_t>(r)]) continue;
+    const double value = distance.row(r).maxCoeff<Eigen::PropagateNaN>();
+    if (std::isnan(value)) return value;
+    largest = std::max(largest, value);
+  }
+  return largest;
+}
+
 double BoxQpSolver::violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                                 const compute::DeviceMatrix& x) {
   return admm_->violationAt(q, bounds, x, C_);
@@ -119,7 +144,8 @@ double BoxQpSolver::violationAt(const compute::DeviceMatrix& q, const compute::R
 
 BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower,
                              const Eigen::MatrixXd& upper, const compute::RelaxedBounds* relaxed,
-                             const compute::DeviceMatrix* start, Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
+                             const compute::DeviceMatrix* start, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                             compute::DeviceMatrix* kept) {
   if (lower.size() > 0 && lower == upper) {
     const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
                         (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
@@ -127,7 +153,10 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
     if (direct) {
       // The direct solve runs here: it reads the values (a device matrix's copy comes over).
       if (start) x = start->values();
-      if (solveEqualities(q.values(), lower, x, y, info)) return info;
+      if (solveEqualities(q.values(), lower, x, y, info)) {
+        if (kept) *kept = compute::DeviceMatrix(std::move(x));
+        return info;
+      }
     }
     // The ADMM of an all-equality problem starts at the initial rho, not at the one the
     // last solve ended at (raised there by the stiff rows): on a 16-face deformation
@@ -146,17 +175,32 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
-  if (polishing && polishInPlace(lower, upper, info)) {
+  // The solution where the ADMM keeps its iterate (`kept`: left there when the ADMM's
+  // kernels can), else downloaded.
+  bool onDevice = false;
+  const auto fetchSolution = [&] {
+    if (kept && !settings_.returnDuals) {
+      if (auto solution = admm_->solution()) {
+        *kept = std::move(*solution);
+        onDevice = true;
+        return;
+      }
+    }
     admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
+  };
+  if (polishing && polishInPlace(lower, upper, info)) {
+    fetchSolution();
   } else if (polishing) {
     Eigen::MatrixXd z;  // the host's polish needs the whole iterate
     admm_->download(x, y, z);
     info.polished = polish(q.values(), lower, upper, z, x, y, info.polishRefinements);
   } else {
-    admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
+    fetchSolution();
   }
-  info.maxBoundViolation = boundViolation(C_ * x, lower, upper);
+  // On the device the kernels measure it at the iterate they keep: the solution.
+  info.maxBoundViolation = onDevice ? admm_->boundViolation() : boundViolation(C_ * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
+  if (kept && !onDevice) *kept = compute::DeviceMatrix(std::move(x));
   return info;
 }
 

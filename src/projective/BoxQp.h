@@ -148,6 +148,16 @@ class BoxQpSolver {
   BoxQpInfo solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                   const compute::DeviceMatrix& start, Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
+  /// The same with the solution left where the ADMM keeps its iterate (a device matrix
+  /// there; host values where the ADMM runs on the host or a host step finished the solve).
+  /// Needs BoxQpSettings::returnDuals off to leave it on a device.
+  BoxQpInfo solve(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
+                  const compute::DeviceMatrix& start, compute::DeviceMatrix& x);
+  /// max |C x - bounds.centre| over all rows (`relaxedRows`) or over the rows not relaxed,
+  /// for the x the last solve gave: measured where the ADMM keeps it when x is a device
+  /// matrix of that solve, else on the host. NaN when C x is not finite.
+  double centreDistance(const compute::DeviceMatrix& x, const compute::RelaxedBounds& bounds, bool relaxedRows);
+
   /// max |C x - bounds.centre| (compute::AdmmSolver::violationAt: where the ADMM runs, which
   /// then holds q and the bounds' centre for the next solve).
   double violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
@@ -178,7 +188,7 @@ class BoxQpSolver {
   /// (when not null) x's warm start (else x on entry).
   BoxQpInfo solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   const compute::RelaxedBounds* relaxed, const compute::DeviceMatrix* start, Eigen::MatrixXd& x,
-                  Eigen::MatrixXd& y);
+                  Eigen::MatrixXd& y, compute::DeviceMatrix* kept = nullptr);
   /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
   /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
   /// by the kernels; only the sides found (a byte per four rows and columns), the active

@@ -115,27 +115,47 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   }
   Eigen::MatrixXd T(4 * faceCount, 3);
   for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
-  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), std::move(shat), positions, result);
+  compute::DeviceMatrix columns;
+  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), shat, positions, columns);
   info.nonPositiveScales = nonPositive;
-  for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = targets[f].col(3);
+  const Eigen::MatrixXd& x = columns.values();
+  result.maps.resize(faceCount);
+  for (Index f = 0; f < faceCount; ++f) {
+    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
+    result.maps[f].col(3) = targets[f].col(3);
+  }
+  result.reciprocalScales = std::move(shat);
   return info;
 }
 
 GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
                                        FaceMaps& result) {
+  compute::DeviceMatrix columns;
+  const GlobalStepInfo info = solveAffine(linearColumns, positions, columns);
+  const Eigen::MatrixXd& x = columns.values();
+  const Index faceCount = space_.faceCount();
+  result.maps.resize(faceCount);
+  for (Index f = 0; f < faceCount; ++f) {
+    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
+    result.maps[f].col(3) = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
+  }
+  result.reciprocalScales.assign(space_.cornerCount(), 1.0);
+  return info;
+}
+
+GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
+                                       compute::DeviceMatrix& resultColumns) {
   const Index faceCount = space_.faceCount();
   if (linearColumns.rows() != 4 * static_cast<Eigen::Index>(faceCount) || linearColumns.cols() != 3) {
     throwUsage("global step: affine targets of " + std::to_string(linearColumns.rows()) + " x " +
                std::to_string(linearColumns.cols()) + " for " + std::to_string(faceCount) + " faces (need 4 #F x 3)");
   }
   // Fourth columns (0, 0, 0, 1): every corner's reciprocal scale factor is 1.
-  GlobalStepInfo info = project(linearColumns, std::vector<double>(space_.cornerCount(), 1.0), positions, result);
-  for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
-  return info;
+  return project(linearColumns, std::vector<double>(space_.cornerCount(), 1.0), positions, resultColumns);
 }
 
-GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, std::vector<double> shat,
-                                   const Positions& positions, FaceMaps& result) {
+GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const std::vector<double>& shat,
+                                   const Positions& positions, compute::DeviceMatrix& x) {
   const Index faceCount = space_.faceCount();
   if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
     throwUsage("global step: " + std::to_string(positions.rows()) + " positions for " +
@@ -158,7 +178,7 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, std::vector<d
     }
     d.row(r) = q;
   }
-  const compute::SparseMatrix& C = constraints_.fill(shat);
+  constraints_.fill(shat);  // the kept solver takes C from it
 
   // C's pattern depends on the topology (and the constrained vertices) only: one solver
   // for the object's lifetime.
@@ -190,17 +210,15 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, std::vector<d
     for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
   }
 
-  Eigen::MatrixXd x;
   bool solved = false;
   for (double eps : schedule) {
     throwIfCancelled("the global step");
     bounds.epsilon = eps;
     // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
     // (its certificate), a poor warm start for the next eps.
-    Eigen::MatrixXd xTry;
-    Eigen::MatrixXd yTry;
+    compute::DeviceMatrix xTry;
     const double startRho = qp.rho();
-    const BoxQpInfo qpInfo = qp.solve(q, bounds, T, xTry, yTry);
+    const BoxQpInfo qpInfo = qp.solve(q, bounds, T, xTry);
     info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
     info.admmIterations += qpInfo.iterations;
     info.factorizations += qpInfo.factorizations;
@@ -237,16 +255,9 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, std::vector<d
                    " ADMM iterations)");
   }
 
-  const Eigen::MatrixXd residual = m > 0 ? Eigen::MatrixXd((C * x - bounds.centre).cwiseAbs()) : Eigen::MatrixXd();
-  for (Eigen::Index r = 0; r < m; ++r) {
-    const double value = residual.row(r).maxCoeff();
-    info.constraintResidual = std::max(info.constraintResidual, value);
-    if (positional[r]) info.positionalResidual = std::max(info.positionalResidual, value);
-  }
-
-  result.maps.resize(faceCount);
-  for (Index f = 0; f < faceCount; ++f) result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
-  result.reciprocalScales = std::move(shat);
+  // Measured where the QP left x (its iterate, on a device: two scalars come back).
+  info.constraintResidual = qp.centreDistance(x, bounds, true);
+  info.positionalResidual = qp.centreDistance(x, bounds, false);
   return info;
 }
 

@@ -117,6 +117,11 @@ class GlobalStep {
   /// initial violation), and Error(Usage) for targets of the wrong size.
   GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
                              FaceMaps& result);
+  /// The same with the result's first three columns (4 #F x 3; fourth columns (0, 0, 0, 1))
+  /// left where the QP solved for them (a device matrix on a device backend, readable while
+  /// this object lives and until its next solve: Error(Usage) after).
+  GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
+                             compute::DeviceMatrix& resultColumns);
 
   const std::vector<Index>& constrainedVertices() const { return constrained_; }
   const GlobalStepSettings& settings() const { return settings_; }
@@ -130,10 +135,10 @@ class GlobalStep {
     Index constrainedSlot;  ///< Index into constrained_ for positional rows, else -1.
   };
 
-  /// Both solves after their target checks: T (4 #F x 3) the targets' first three columns,
-  /// shat their reciprocal scales; writes the maps' first three columns and the scales.
-  GlobalStepInfo project(const compute::DeviceMatrix& T, std::vector<double> shat, const Positions& positions,
-                         FaceMaps& result);
+  /// The solves after their target checks: T (4 #F x 3) the targets' first three columns,
+  /// shat their reciprocal scales; x receives the maps' first three columns (4 #F x 3).
+  GlobalStepInfo project(const compute::DeviceMatrix& T, const std::vector<double>& shat, const Positions& positions,
+                         compute::DeviceMatrix& x);
 
   compute::Backend& backend_;
   const ShapeSpace& space_;

@@ -343,6 +343,20 @@ TEST_F(VulkanIdealMaps, AnAffineGlobalStepOnKeptMapsUploadsNoTargetsAndIsTheStep
   EXPECT_EQ(a.admmIterations, b.admmIterations);
   ASSERT_EQ(onDevice.maps.size(), fromHost.maps.size());
   for (std::size_t f = 0; f < onDevice.maps.size(); ++f) EXPECT_EQ(onDevice.maps[f], fromHost.maps[f]) << "face " << f;
+
+  // The result's columns can stay where the QP solved for them too: the same values, the
+  // residuals measured there (the host's to rounding).
+  compute::DeviceMatrix columns;
+  projective::GlobalStep keeping(backend(), space, fixed);  // the columns live with its solver
+  const projective::GlobalStepInfo c = keeping.solveAffine(kept, at, columns);
+  EXPECT_FALSE(columns.onHost());
+  const Eigen::MatrixXd& x = columns.values();
+  for (std::size_t f = 0; f < onDevice.maps.size(); ++f) {
+    EXPECT_EQ(x.middleRows<4>(4 * static_cast<Eigen::Index>(f)), onDevice.maps[f].leftCols<3>()) << "face " << f;
+  }
+  EXPECT_NEAR(c.constraintResidual, b.constraintResidual, 1e-15);
+  EXPECT_NEAR(c.positionalResidual, b.positionalResidual, 1e-15);
+  EXPECT_GT(c.constraintResidual, 0.0);
 }
 
 TEST_F(VulkanIdealMaps, TheFusedLocalStepOfATargetOfOtherSizeIsAUsageErrorOnBothBackends) {

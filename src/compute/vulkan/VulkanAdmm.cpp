@@ -289,6 +289,7 @@ struct AdmmKernels::Workspace {
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
+  bool relaxedStart = false;  ///< The last start formed l and u from w.centre and w.relaxed.
   Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
   /// The resident maps' generation whose -T w.q holds (0: none; uploadedQ is then what it holds).
   std::uint64_t residentQGeneration = 0;
@@ -904,6 +905,7 @@ void AdmmKernels::finishStart(const compute::DeviceMatrix& q, const compute::Dev
   w.innerIterationsSeen = 0.0;
   w.uploadedTolerance = -1.0;
   w.polishStartSaved = false;
+  w.relaxedStart = relaxedBounds;
   cappedSolves_ = 0;
   longFirstSolve_ = true;
   const int key = static_cast<int>(xStart) + 3 * (zeroY ? 1 : 0) + 6 * (relaxedBounds ? 1 : 0);
@@ -974,6 +976,59 @@ void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::Matrix
     return;
   }
   workspace_->z.download(z);
+}
+
+/// A copy of the ADMM's x on the device (AdmmKernels::solution), readable while the kernels
+/// that made it hold it: they outlive neither a later solution() nor their own destruction.
+class AdmmKernels::SolutionSource final : public compute::DeviceMatrixSource {
+ public:
+  SolutionSource(const DeviceVectors& vectors, std::uint64_t generation, std::weak_ptr<const std::uint64_t> live)
+      : vectors_(vectors), generation_(generation), live_(std::move(live)) {}
+  void fetch(Eigen::MatrixXd& out) const override {
+    const auto live = live_.lock();
+    if (!live || *live != generation_) {
+      throwUsage("ADMM solution on the device: it was replaced (or its solver destroyed) before it was read");
+    }
+    vectors_.download(out);
+  }
+
+ private:
+  const DeviceVectors& vectors_;
+  std::uint64_t generation_;
+  std::weak_ptr<const std::uint64_t> live_;
+};
+
+std::optional<compute::DeviceMatrix> AdmmKernels::solution() {
+  if (!workspace_) return compute::DeviceMatrix(Eigen::MatrixXd(n_, 0));  // k = 0: nothing to keep
+  Workspace& w = *workspace_;
+  ++*solutionGeneration_;  // the last solution's copy is overwritten (or reallocated) below
+  if (!solution_ || solution_->m() != w.k) solution_ = std::make_unique<DeviceVectors>(context_, n_, w.k, "ADMM solution");
+  Sequence s(context_);
+  s.begin();
+  algebra_.copy(s, w.x, *solution_);
+  s.end();
+  s.run();
+  return compute::DeviceMatrix(static_cast<Eigen::Index>(n_), static_cast<Eigen::Index>(w.k),
+                               std::make_shared<const SolutionSource>(*solution_, *solutionGeneration_,
+                                                                      solutionGeneration_));
+}
+
+std::optional<double> AdmmKernels::centreDistance(bool relaxedRows) {
+  if (!workspace_ || m_ == 0) return 0.0;
+  Workspace& w = *workspace_;
+  if (!w.relaxedStart) return std::nullopt;
+  // l = u = the centre on every row (epsilon 0), or only on the rows not relaxed (the
+  // relaxed ones' bounds as wide as doubles go).
+  const double epsilon = relaxedRows ? 0.0 : std::numeric_limits<double>::max();
+  w.state.upload({&epsilon, 1}, kStateEpsilon);
+  Sequence s(context_);
+  s.begin();
+  const std::uint32_t count = m_ * w.k;
+  s.dispatch(relaxedBounds_, {w.centre.data(), w.relaxed, w.state, w.lower.data(), w.upper.data()},
+             RelaxedBoundsPush{std::max<std::uint32_t>(m_, 1), count, kStateEpsilon}, groupsFor(context_, count));
+  s.end();
+  s.run();
+  return boundViolation();
 }
 
 void AdmmKernels::downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) {

@@ -154,10 +154,16 @@ class AdmmKernels final : public compute::AdmmKernels {
   bool findActiveSides(std::vector<compute::BoundSide>& sides) override;
   /// One check-sized read (shaders/admm_bound_violation.comp, then the inf-norms).
   double boundViolation() override;
+  /// A device copy of x (one copy kernel, nothing read back).
+  std::optional<compute::DeviceMatrix> solution() override;
+  /// The relaxed bounds formed again with epsilon 0 (or the largest double), then
+  /// boundViolation(): one check-sized read. The next start forms its own.
+  std::optional<double> centreDistance(bool relaxedRows) override;
   void discardRefinement() override;
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
+  class SolutionSource;
   void prepare(std::uint32_t k);
   Sequence& block(int count, bool longFirstSolve);
   /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
@@ -253,6 +259,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   bool longFirstSolve_ = true;       ///< The next block starts after start() or setRho().
   double linearTolerance_ = 0.0;     ///< Bound on each column's ||r|| of the inner solves.
   std::unique_ptr<Workspace> workspace_;
+  /// solution()'s copy of x and its generation, watched (weakly) by the copies' sources.
+  std::unique_ptr<DeviceVectors> solution_;
+  std::shared_ptr<std::uint64_t> solutionGeneration_ = std::make_shared<std::uint64_t>(0);
 };
 
 }  // namespace plano::vk
