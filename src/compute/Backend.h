@@ -66,6 +66,20 @@ struct DeviceIdealMaps {
   Index firstCentroidAtInfinity = -1;  ///< The lowest such face, or -1.
 };
 
+/// Which corners meet at each vertex (projective::ShapeSpace's tables).
+struct VertexCorners {
+  std::span<const Index> offsets;     ///< #V + 1: vertex v's corners are corners[offsets[v] .. offsets[v + 1]).
+  std::span<const Index> corners;     ///< Corner indices, FaceList CSR order.
+  std::span<const Index> cornerFace;  ///< Per corner, its face.
+};
+
+/// Backend::affinePositions's result.
+struct AffinePositions {
+  DeviceMatrix positions;      ///< #V x 3, the base positions' coordinates.
+  double displacement = 0.0;   ///< max over vertices of |positions - previous|.
+  double maxPlanarity = 0.0;   ///< Largest face planarity at `positions` (percent, mesh/Planarity.h).
+};
+
 /// Backend::closestIdealMaps's input checks, one for every backend: Error(Usage) unless
 /// `fitted` has one map per face and `target` (when given) as many rows as `source`.
 void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::span<const Eigen::Matrix4d> fitted,
@@ -74,6 +88,10 @@ void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::sp
 /// Backend::fitProjectiveMaps's input check, one for every backend: Error(Usage) unless
 /// `target` has as many rows as `source`.
 void checkFitInputs(const Positions& source, const Positions& target);
+
+/// Backend::affinePositions's input checks, one for every backend (Error(Usage)).
+void checkAffinePositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous);
 
 /// Settings of an iterative or direct SPD solve.
 struct LinearSolverSettings {
@@ -171,8 +189,20 @@ class Backend {
   /// fitIdealMaps with the maps left where they were computed: the host reads only the
   /// methods' tallies, and the maps when a caller reads linearColumns' values. The default
   /// runs fitIdealMaps and keeps its maps on the host.
-  virtual void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+  /// `target` may be a device matrix of this backend (affinePositions'): bound, not copied.
+  virtual void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
                                     bool similar, DeviceIdealMaps& out);
+
+  /// Vertex positions of affine face maps given by their first three columns (4 #F x 3,
+  /// fourth columns (0, 0, 0, 1); projective::ShapeSpace::normalizedPositions for such maps):
+  /// each vertex the mean of its corner images (p, 1) A_f over the faces sharing it (p its
+  /// row of `base`), an isolated vertex its base position; with the largest distance of a
+  /// vertex from `previous` (#V x 3) and the largest planarity of `faces` there. A device
+  /// backend keeps the positions on the device (two scalars come back) and binds inputs
+  /// that are its own device matrices. Throws Error(Usage) for inputs of the wrong sizes,
+  /// Error(Numerical) when a position is not finite.
+  virtual void affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out);
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;

@@ -2,6 +2,7 @@
 #include "compute/cpu/CpuBackend.h"
 #include "compute/vulkan/VulkanBackend.h"
 #include "core/Error.h"
+#include "mesh/Planarity.h"
 
 namespace plano::compute {
 
@@ -43,10 +44,10 @@ void Backend::fitIdealMaps(const FaceList& faces, const Positions& source, const
   closestIdealMaps(faces, source, fits.maps, &target, similar, out);
 }
 
-void Backend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+void Backend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
                                    bool similar, DeviceIdealMaps& out) {
   IdealMaps ideal;
-  fitIdealMaps(faces, source, target, similar, ideal);
+  fitIdealMaps(faces, source, Positions(target.values()), similar, ideal);
   const auto faceCount = static_cast<Index>(ideal.maps.size());
   Eigen::MatrixXd columns(4 * static_cast<Eigen::Index>(faceCount), 3);
   out.cornerProcrustes = 0;
@@ -60,6 +61,48 @@ void Backend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& sourc
     }
   }
   out.linearColumns = DeviceMatrix(std::move(columns));
+}
+
+void checkAffinePositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous) {
+  const auto vertexCount = static_cast<std::size_t>(base.rows());
+  if (corners.offsets.size() != vertexCount + 1 || corners.corners.size() != corners.cornerFace.size() ||
+      static_cast<std::size_t>(corners.offsets.back()) != corners.corners.size() ||
+      corners.cornerFace.size() != static_cast<std::size_t>(faces.cornerCount())) {
+    throwUsage("affinePositions: vertex corner tables of the wrong sizes for " + std::to_string(vertexCount) +
+               " vertices and " + std::to_string(faces.cornerCount()) + " corners");
+  }
+  if (mapColumns.rows() != 4 * static_cast<Eigen::Index>(faces.size()) || mapColumns.cols() != 3) {
+    throwUsage("affinePositions: map columns of " + std::to_string(mapColumns.rows()) + " x " +
+               std::to_string(mapColumns.cols()) + " for " + std::to_string(faces.size()) + " faces");
+  }
+  if (previous.rows() != base.rows() || previous.cols() != 3) {
+    throwUsage("affinePositions: previous positions of " + std::to_string(previous.rows()) + " rows for " +
+               std::to_string(vertexCount) + " vertices");
+  }
+}
+
+void Backend::affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                              const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out) {
+  checkAffinePositionInputs(faces, base, corners, mapColumns, previous);
+  const Eigen::MatrixXd& X = mapColumns.values();
+  Positions positions = base;
+  for (Eigen::Index v = 0; v < base.rows(); ++v) {
+    const Index begin = corners.offsets[v];
+    const Index end = corners.offsets[v + 1];
+    if (begin == end) continue;
+    const Eigen::RowVector4d p(base(v, 0), base(v, 1), base(v, 2), 1.0);
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    for (Index k = begin; k < end; ++k) {
+      const Eigen::Matrix<double, 4, 3> M = X.middleRows<4>(4 * static_cast<Eigen::Index>(corners.cornerFace[corners.corners[k]]));
+      sum += p * M;
+    }
+    positions.row(v) = sum / static_cast<double>(end - begin);
+  }
+  if (!positions.allFinite()) throwNumerical("affinePositions: a vertex position from the maps is not finite");
+  out.displacement = maxVertexDistance(Positions(previous.values()), positions);
+  out.maxPlanarity = planarityStats(PolygonMesh{positions, faces}).max;
+  out.positions = DeviceMatrix(Eigen::MatrixXd(positions));
 }
 
 BackendChoice parseBackendChoice(const std::string& text) {

@@ -4,7 +4,9 @@
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "mesh/Planarity.h"
 #include "projective/ConstrainedVertices.h"
+#include "projective/IdealMaps.h"
 #include "projective/LocalStep.h"
 
 namespace plano::projective {
@@ -45,7 +47,8 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
   const double planarityBound = std::max(settings_.planarityTolerance, planarityStats(space_.baseMesh()).max);
   DeformationInfo info;
   std::optional<compute::DeviceTransfers> transfersBefore;
-  auto record = [&](DeformationPhase phase, const GlobalStepInfo& step, const Positions& next) {
+  // displacement: normalized units (world distance over the diagonal's scale).
+  auto record = [&](DeformationPhase phase, const GlobalStepInfo& step, double displacement, double planarity) {
     DeformationIteration it;
     it.transfers = compute::transfersSince(transfersBefore, backend_.transfers());
     it.iteration = ++info.iterations;
@@ -57,13 +60,19 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     it.admmIterations = step.admmIterations;
     it.linearIterations = step.linearIterations;
     it.attempts = step.attempts;
-    it.displacement = maxVertexDistance(next, positions) / diagonal;
-    it.maxPlanarity = planarityStats(PolygonMesh{next, space_.faces()}).max;
+    it.displacement = displacement;
+    it.maxPlanarity = planarity;
     info.history.push_back(it);
     if (callback) callback(it);
     return it;
   };
 
+  // Phase 1's positions, normalized, where the backend computes them: on a device the loop
+  // below moves no mesh-sized data between host and device (the ideal maps, the global
+  // step's solution and these positions stay there; scalars come back).
+  compute::DeviceMatrix current(Eigen::MatrixXd(space_.normalization().toNormalized(positions)));
+  bool currentIsNewer = false;  // `current` holds positions that `positions` does not yet
+  const compute::VertexCorners corners = space_.vertexCorners();
   try {
     bool converged = false;
     FaceMaps maps;
@@ -71,14 +80,18 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       throwIfCancelled("deformation");
       transfersBefore = backend_.transfers();
-      // The ideal maps stay where the backend computed them: the global step's QP reads them there.
-      const compute::DeviceMatrix ideal = fittedIdealMapsOnDevice(backend_, space_, positions, settings_.energy);
-      const GlobalStepInfo step = global_.solveAffine(ideal, targets, maps);
-      const Positions next = space_.positions(maps.maps);
-      const DeformationIteration it = record(DeformationPhase::Ideal, step, next);
-      positions = next;
+      const compute::DeviceMatrix ideal = idealMapsOfNormalized(backend_, space_, current, settings_.energy);
+      compute::DeviceMatrix columns;
+      const GlobalStepInfo step = global_.solveAffine(ideal, targets, columns);
+      compute::AffinePositions next;
+      backend_.affinePositions(space_.faces(), space_.basePositions(), corners, columns, current, next);
+      const DeformationIteration it = record(DeformationPhase::Ideal, step, next.displacement, next.maxPlanarity);
+      current = std::move(next.positions);
+      currentIsNewer = true;
       converged = it.displacement < settings_.tolerance;
     }
+    if (currentIsNewer) positions = space_.normalization().toWorld(Positions(current.values()));
+    currentIsNewer = false;
     // Phase 2 (§5 loop): projective fits of the current faces, projected with the same
     // constraints, until the faces are planar again.
     bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
@@ -88,7 +101,9 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
       const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
       const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
       const Positions next = space_.positions(maps.maps);
-      planar = record(DeformationPhase::Projection, step, next).maxPlanarity <= planarityBound;
+      const double displacement = maxVertexDistance(next, positions) / diagonal;
+      planar = record(DeformationPhase::Projection, step, displacement, planarityStats(PolygonMesh{next, space_.faces()}).max)
+                   .maxPlanarity <= planarityBound;
       positions = next;
     }
     info.status = converged && planar ? DeformationStatus::Converged : DeformationStatus::MaxIterationsReached;
@@ -96,6 +111,8 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     if (e.kind() != ErrorKind::Numerical) throw;
     info.status = DeformationStatus::NumericalFailure;
     info.message = e.what();
+    // The last positions the loop computed (their array is never the one a failed step wrote).
+    if (currentIsNewer) positions = space_.normalization().toWorld(Positions(current.values()));
   }
 
   info.planarity = planarityStats(PolygonMesh{positions, space_.faces()});

@@ -60,7 +60,17 @@ std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const Sh
 
 compute::DeviceMatrix fittedIdealMapsOnDevice(compute::Backend& backend, const ShapeSpace& space,
                                               const Positions& target, IdealMapKind kind, Index* fallbacks) {
-  const Positions normalizedTarget = normalizedTargetPositions(space, target);
+  return idealMapsOfNormalized(backend, space, normalizedTargetPositions(space, target), kind, fallbacks);
+}
+
+compute::DeviceMatrix idealMapsOfNormalized(compute::Backend& backend, const ShapeSpace& space,
+                                            const compute::DeviceMatrix& normalizedTarget, IdealMapKind kind,
+                                            Index* fallbacks) {
+  if (normalizedTarget.rows() != space.vertexCount() || normalizedTarget.cols() != 3) {
+    throwUsage("ideal maps: " + std::to_string(normalizedTarget.rows()) + " x " +
+               std::to_string(normalizedTarget.cols()) + " target positions for " +
+               std::to_string(space.vertexCount()) + " vertices");
+  }
   compute::DeviceIdealMaps ideal;
   backend.fitIdealMapsOnDevice(space.faces(), space.basePositions(), normalizedTarget,
                                kind == IdealMapKind::Similar, ideal);

@@ -59,5 +59,10 @@ std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const Sh
 /// solveAffine's targets; fourth columns (0, 0, 0, 1)). The same checks and errors.
 compute::DeviceMatrix fittedIdealMapsOnDevice(compute::Backend& backend, const ShapeSpace& space,
                                               const Positions& target, IdealMapKind kind, Index* fallbacks = nullptr);
+/// The same for target positions already in normalized coordinates (#V x 3), which may be a
+/// device matrix of the backend's (Backend::affinePositions): bound where they are.
+compute::DeviceMatrix idealMapsOfNormalized(compute::Backend& backend, const ShapeSpace& space,
+                                            const compute::DeviceMatrix& normalizedTarget, IdealMapKind kind,
+                                            Index* fallbacks = nullptr);
 
 }  // namespace plano::projective

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "compute/Backend.h"
 #include "mesh/PolygonMesh.h"
 #include "projective/Normalization.h"
 
@@ -45,6 +46,8 @@ class ShapeSpace {
   /// Corners of vertex v: cornersOfVertex[vertexCornerOffsets[v] .. vertexCornerOffsets[v+1]).
   const std::vector<Index>& vertexCornerOffsets() const { return vertexCornerOffsets_; }
   const std::vector<Index>& cornersOfVertex() const { return cornersOfVertex_; }
+  /// These tables and each corner's face, as a backend takes them (Backend::affinePositions).
+  compute::VertexCorners vertexCorners() const { return {vertexCornerOffsets_, cornersOfVertex_, cornerFace_}; }
   Index vertexDegree(Index v) const { return vertexCornerOffsets_[v + 1] - vertexCornerOffsets_[v]; }
   /// Pairs (f, g), f < g, of faces sharing an edge (the smoothness term of §6.3).
   const std::vector<std::pair<Index, Index>>& adjacentFaces() const { return adjacentFaces_; }

@@ -27,15 +27,20 @@ double relativeDifference(const Positions& a, const Positions& b) {
   return (a - b).rowwise().norm().maxCoeff() / boundingBoxDiagonal(b);
 }
 
-using WholeAlgorithmAgreement = VulkanTest;
-
-TEST_F(WholeAlgorithmAgreement, SingleLevelDeformationGivesTheCpuMeshWithTheSameIterations) {
-  const Index n = 4;
-  const PolygonMesh grid = generate::translationalSurface(n, n);
+/// An n x n translational grid's first column of vertices fixed, its far corner lifted.
+PositionalConstraints fixedRowAndLiftedCorner(const PolygonMesh& grid, Index n) {
   PositionalConstraints constraints;
   for (Index i = 0; i <= n; ++i) constraints.fixed.push_back(i * (n + 1));
   const Index corner = n * (n + 1) + n;
   constraints.handles.push_back({corner, grid.vertices.row(corner).transpose() + Eigen::Vector3d(0.1, 0.1, 0.3)});
+  return constraints;
+}
+
+using WholeAlgorithmAgreement = VulkanTest;
+
+TEST_F(WholeAlgorithmAgreement, SingleLevelDeformationGivesTheCpuMeshWithTheSameIterations) {
+  const PolygonMesh grid = generate::translationalSurface(4, 4);
+  const PositionalConstraints constraints = fixedRowAndLiftedCorner(grid, 4);
   compute::CpuBackend cpu;
   const projective::DeformationResult reference = projective::deform(cpu, grid, constraints);
   const projective::DeformationResult result = projective::deform(backend(), grid, constraints);
@@ -44,6 +49,35 @@ TEST_F(WholeAlgorithmAgreement, SingleLevelDeformationGivesTheCpuMeshWithTheSame
   EXPECT_EQ(result.info.iterations, reference.info.iterations);
   EXPECT_LT(relativeDifference(result.mesh.vertices, reference.mesh.vertices), kAgreement);
   EXPECT_LT(result.info.planarity.max, 1e-6);
+}
+
+TEST_F(WholeAlgorithmAgreement, ASteadyDeformationIterationCopiesNoMeshSizedArray) {
+  // After the first iteration (which uploads the solvers' matrices and the topology), the
+  // rigid loop keeps its ideal maps, the global step's solution and the positions on the
+  // device: each copy is a check's scalars or packed flags, far below the smallest mesh-
+  // sized array (the positions, 24 B a vertex; the solution 96 B a face).
+  const PolygonMesh grid = generate::translationalSurface(6, 6);
+  const PositionalConstraints constraints = fixedRowAndLiftedCorner(grid, 6);
+  projective::DeformationSettings settings;
+  settings.maxIterations = 4;
+  settings.maxProjectionIterations = 0;
+  std::vector<vk::TransferCounts> steady;
+  const auto result = projective::deform(backend(), grid, constraints, settings, [&](const projective::DeformationIteration& it) {
+    if (it.iteration > 1) steady.push_back(context().transfers());
+    context().resetLargestTransfers();
+  });
+  ASSERT_EQ(steady.size(), 3u);
+  const auto positionBytes = static_cast<std::uint64_t>(grid.vertices.size()) * sizeof(double);
+  for (const vk::TransferCounts& counts : steady) {
+    EXPECT_GT(counts.largestDownload, 0u);
+    EXPECT_LT(counts.largestDownload, positionBytes / 4) << "a mesh-sized array came back";
+    EXPECT_LT(counts.largestUpload, positionBytes / 4) << "a mesh-sized array went up";
+  }
+  // The mesh is the CPU's, and the final positions came back.
+  compute::CpuBackend cpu;
+  const auto reference = projective::deform(cpu, grid, constraints, settings);
+  EXPECT_LT(relativeDifference(result.mesh.vertices, reference.mesh.vertices), kAgreement);
+  EXPECT_GT((result.mesh.vertices - grid.vertices).cwiseAbs().maxCoeff(), 0.05);
 }
 
 TEST_F(WholeAlgorithmAgreement, CubeSubdivisionGivesTheCpuMeshWithTheSameIterations) {

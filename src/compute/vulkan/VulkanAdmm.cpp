@@ -107,6 +107,10 @@ compute::SparseMatrix unionPatternK0(const compute::SparseMatrix& P, const compu
 struct CountPush {  // admm_scaled_values
   std::uint32_t count;
 };
+struct ActiveFlagsPush {  // admm_active_flags
+  std::uint32_t m;
+  std::uint32_t column;
+};
 struct NegatedMapsPush {  // admm_negated_maps
   std::uint32_t faceCount;
   std::uint32_t columns;
@@ -325,6 +329,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
                      "ADMM preconditioner blocks"),
       rhoRows_(context, m_, MemoryClass::Device, "ADMM rho per row"),
       rowScales_(context, m_, MemoryClass::Device, "ADMM rho scale per row"),
+      admmRowScales_(context, m_, MemoryClass::Device, "ADMM rho scale per row (kept)"),
       blockFailure_(context, 1, MemoryClass::Host, "ADMM preconditioner status"),
       coarseFailure_(context, 1, MemoryClass::Host, "ADMM multigrid status"),
       recording_(recording),
@@ -346,6 +351,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       polishTargets_(context, "admm_polish_targets", 4, sizeof(CountPush)),
       boundViolation_(context, "admm_bound_violation", 4, sizeof(CountPush)),
       negatedMaps_(context, "admm_negated_maps", 2, sizeof(NegatedMapsPush)),
+      activeFlags_(context, "admm_active_flags", 2, sizeof(ActiveFlagsPush)),
       assembly_(context),
       innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
   C_.makeCompressed();
@@ -404,11 +410,25 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   // mesh-sized upload here. A rho update alone moves no mesh-sized data: K, the per-row
   // penalties and the preconditioner's blocks are recomputed on the device; one flag
   // comes back.
+  // D of an unchanged pattern is kept on the device: K1 formed again after a polish (whose
+  // flags replaced the row scales) or for new values of C copies it there.
   if (!k1Current_ || equality != equality_) {
-    std::vector<double> D(m_);
-    for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
-    assembleK1(D);
-    equality_ = equality;
+    if (equality != equality_ || !admmRowScalesHeld_) {
+      admmRowScalesHeld_ = false;
+      std::vector<double> D(m_);
+      for (std::uint32_t i = 0; i < m_; ++i) D[i] = equality[i] ? settings_.equalityRhoScale : 1.0;
+      admmRowScales_.upload(D);
+      equality_ = equality;
+      admmRowScalesHeld_ = true;
+    }
+    if (m_ > 0) {
+      Sequence copy(context_);
+      copy.begin();
+      copy.copy(admmRowScales_, rowScales_, std::size_t{m_} * sizeof(double));
+      copy.end();
+      copy.run();
+    }
+    assembleK1FromRowScales(-1);
     k1Current_ = true;
   }
   assembleK(rho);
@@ -417,8 +437,17 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
 
 void AdmmKernels::assembleK1(const std::vector<double>& rowScales) {
   rowScales_.upload(rowScales);
+  assembleK1FromRowScales(-1);
+}
+
+void AdmmKernels::assembleK1FromRowScales(int sidesColumn) {
   const auto nonZeros = static_cast<std::uint32_t>(K0_.nonZeros());
   assembly_.begin();
+  if (sidesColumn >= 0) {
+    assembly_.dispatch(activeFlags_, {workspace_->sides, rowScales_},
+                       ActiveFlagsPush{m_, static_cast<std::uint32_t>(sidesColumn)}, groupsFor(context_, m_));
+    assembly_.barrier();
+  }
   assembly_.dispatch(k1Assemble_,
                      {k1TermOffsets_, k1TermA_, k1TermB_, devC_.values(), cEntryRows_, rowScales_, k1Values_},
                      K1AssemblePush{nonZeros}, groupsFor(context_, nonZeros));
@@ -978,26 +1007,6 @@ void AdmmKernels::download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::Matrix
   workspace_->z.download(z);
 }
 
-/// A copy of the ADMM's x on the device (AdmmKernels::solution), readable while the kernels
-/// that made it hold it: they outlive neither a later solution() nor their own destruction.
-class AdmmKernels::SolutionSource final : public compute::DeviceMatrixSource {
- public:
-  SolutionSource(const DeviceVectors& vectors, std::uint64_t generation, std::weak_ptr<const std::uint64_t> live)
-      : vectors_(vectors), generation_(generation), live_(std::move(live)) {}
-  void fetch(Eigen::MatrixXd& out) const override {
-    const auto live = live_.lock();
-    if (!live || *live != generation_) {
-      throwUsage("ADMM solution on the device: it was replaced (or its solver destroyed) before it was read");
-    }
-    vectors_.download(out);
-  }
-
- private:
-  const DeviceVectors& vectors_;
-  std::uint64_t generation_;
-  std::weak_ptr<const std::uint64_t> live_;
-};
-
 std::optional<compute::DeviceMatrix> AdmmKernels::solution() {
   if (!workspace_) return compute::DeviceMatrix(Eigen::MatrixXd(n_, 0));  // k = 0: nothing to keep
   Workspace& w = *workspace_;
@@ -1008,9 +1017,12 @@ std::optional<compute::DeviceMatrix> AdmmKernels::solution() {
   algebra_.copy(s, w.x, *solution_);
   s.end();
   s.run();
-  return compute::DeviceMatrix(static_cast<Eigen::Index>(n_), static_cast<Eigen::Index>(w.k),
-                               std::make_shared<const SolutionSource>(*solution_, *solutionGeneration_,
-                                                                      solutionGeneration_));
+  const auto rows = static_cast<Eigen::Index>(n_);
+  const auto cols = static_cast<Eigen::Index>(w.k);
+  return compute::DeviceMatrix(rows, cols,
+                               std::make_shared<const ArraySource>(context_, solution_->data(), ArrayLayout::ColumnMajor,
+                                                                   rows, cols, *solutionGeneration_,
+                                                                   solutionGeneration_));
 }
 
 std::optional<double> AdmmKernels::centreDistance(bool relaxedRows) {
@@ -1109,19 +1121,6 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     w.polishStartSaved = true;
   }
 
-  // K_A = K0 + rho C^T diag(active) C: the ADMM's K with the active flags as row scales.
-  std::vector<double> flags(m_);
-  for (std::uint32_t i = 0; i < m_; ++i) flags[i] = request.active[i] ? 1.0 : 0.0;
-  k1Current_ = false;  // K1 is the polish's from here on; the next setRho forms the ADMM's
-  longFirstSolve_ = true;
-  try {
-    assembleK1(flags);
-    assembleK(request.rho);
-  } catch (const Error& e) {
-    if (e.kind() != ErrorKind::Numerical) throw;
-    return true;  // not factored: the ADMM's solution stands
-  }
-  info.factored = true;
   if (bySides) {
     // The sides findActiveSides found are on the device already.
     const std::vector<std::uint32_t> packed = packSides(request.sides);
@@ -1130,6 +1129,36 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
       w.sides.upload(packed);
       w.heldSides = packed;
     }
+  }
+  // K_A = K0 + rho C^T diag(active) C: the ADMM's K with the active flags as row scales,
+  // formed from the sides on the device when the flags are a column's sides (the polish's
+  // sets are), else uploaded.
+  int sidesColumn = -1;
+  if (bySides && !request.columns.empty()) {
+    const auto c = static_cast<std::size_t>(request.columns.front());
+    bool fromSides = true;
+    for (std::uint32_t i = 0; i < m_ && fromSides; ++i) {
+      fromSides = (request.sides[c * m_ + i] != compute::BoundSide::Free) == (request.active[i] != 0);
+    }
+    if (fromSides) sidesColumn = static_cast<int>(c);
+  }
+  k1Current_ = false;  // K1 is the polish's from here on; the next setRho forms the ADMM's
+  longFirstSolve_ = true;
+  try {
+    if (sidesColumn >= 0) {
+      assembleK1FromRowScales(sidesColumn);
+    } else {
+      std::vector<double> flags(m_);
+      for (std::uint32_t i = 0; i < m_; ++i) flags[i] = request.active[i] ? 1.0 : 0.0;
+      assembleK1(flags);
+    }
+    assembleK(request.rho);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Numerical) throw;
+    return true;  // not factored: the ADMM's solution stands
+  }
+  info.factored = true;
+  if (bySides) {
     recordedOnce(p.targets, context_, [&](Sequence& s) {
       const std::uint32_t count = m_ * w.k;
       s.dispatch(polishTargets_, {w.sides, w.lower.data(), w.upper.data(), w.z.data()}, CountPush{count},

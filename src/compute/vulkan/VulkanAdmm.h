@@ -47,6 +47,7 @@
 
 #include "compute/Admm.h"
 #include "compute/BlockMultigrid.h"
+#include "compute/vulkan/VulkanDeviceMatrix.h"
 #include "compute/vulkan/VulkanIdealMaps.h"
 #include "compute/vulkan/VulkanLinearAlgebra.h"
 #include "compute/vulkan/VulkanMultigrid.h"
@@ -154,7 +155,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   bool findActiveSides(std::vector<compute::BoundSide>& sides) override;
   /// One check-sized read (shaders/admm_bound_violation.comp, then the inf-norms).
   double boundViolation() override;
-  /// A device copy of x (one copy kernel, nothing read back).
+  /// A device copy of x (one copy kernel, nothing read back; an ArraySource, ColumnMajor).
   std::optional<compute::DeviceMatrix> solution() override;
   /// The relaxed bounds formed again with epsilon 0 (or the largest double), then
   /// boundViolation(): one check-sized read. The next start forms its own.
@@ -163,12 +164,14 @@ class AdmmKernels final : public compute::AdmmKernels {
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
-  class SolutionSource;
   void prepare(std::uint32_t k);
   Sequence& block(int count, bool longFirstSolve);
   /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
   /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
   void assembleK1(const std::vector<double>& rowScales);
+  /// The same with the row scales already in rowScales_, or (sidesColumn >= 0) formed there
+  /// from that column's active sides (shaders/admm_active_flags.comp).
+  void assembleK1FromRowScales(int sidesColumn);
   void assembleK(double rho);
   /// How start() sets x: uploaded, zero, or -q (each formed on the device but the first).
   enum class StartX { Uploaded, Zero, NegatedQ };
@@ -244,6 +247,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   Array<double> inverseBlocks_;      ///< n / block_ inverse diagonal blocks of K, row-major.
   Array<double> rhoRows_;            ///< rho per constraint row.
   Array<double> rowScales_;          ///< D per constraint row: rhoRows_ = rho D.
+  Array<double> admmRowScales_;      ///< The ADMM's D for equality_ (rowScales_ may hold the polish's flags).
+  bool admmRowScalesHeld_ = false;   ///< admmRowScales_ holds D for equality_.
   Array<std::uint32_t> blockFailure_;  ///< First block of K that is not positive definite, or ~0.
   std::unique_ptr<compute::BlockAggregation> aggregation_;  ///< AdmmPreconditioner::Multigrid only.
   std::unique_ptr<Multigrid> multigrid_;
@@ -251,7 +256,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
-  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_, negatedMaps_;
+  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_, negatedMaps_, activeFlags_;
   const ResidentFaceMaps* residentMaps_ = nullptr;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.

@@ -1,6 +1,9 @@
 #include "compute/vulkan/VulkanBackend.h"
 
+#include <algorithm>
+
 #include "compute/vulkan/VulkanAdmm.h"
+#include "compute/vulkan/VulkanAffinePositions.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "compute/vulkan/VulkanClosestRotations.h"
 #include "compute/vulkan/VulkanIdealMaps.h"
@@ -68,18 +71,48 @@ void VulkanBackend::fitIdealMaps(const FaceList& faces, const Positions& source,
   idealMaps_->runOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
 }
 
-void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target,
+void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
                                          bool similar, DeviceIdealMaps& out) {
   if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   const bool oneBinding = faceCount <= context_->info().maxStorageBufferRange / (16 * sizeof(double));
-  const vk::Array<double>* fits = oneBinding ? projectiveFit_->runResident(faces, source, target) : nullptr;
+  // Positions this backend computed (affinePositions) are bound where they are.
+  const vk::Array<double>* residentTarget =
+      target.rows() == source.rows() && target.cols() == 3 ? vk::arrayOf(target, *context_, vk::ArrayLayout::RowMajor)
+                                                           : nullptr;
+  Positions hostTarget;
+  if (!residentTarget) hostTarget = target.values();
+  const vk::Array<double>* fits = nullptr;
+  if (oneBinding) {
+    fits = residentTarget ? projectiveFit_->runResidentOn(faces, source, *residentTarget)
+                          : projectiveFit_->runResident(faces, source, hostTarget);
+  }
   if (!fits) {  // no faces, or more maps than one binding holds: the host keeps them
     Backend::fitIdealMapsOnDevice(faces, source, target, similar, out);
     return;
   }
   if (!idealMaps_) idealMaps_ = std::make_unique<vk::IdealMapsKernel>(*context_, residentMaps_.get());
-  idealMaps_->keepOnResidentFits(faces, source, *fits, target, projectiveFit_->targetHolding(target), similar, out);
+  if (residentTarget) {
+    idealMaps_->keepOnResidentFits(faces, source, *fits, nullptr, residentTarget, similar, out);
+  } else {
+    idealMaps_->keepOnResidentFits(faces, source, *fits, &hostTarget, projectiveFit_->targetHolding(hostTarget),
+                                   similar, out);
+  }
+}
+
+void VulkanBackend::affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                                    const DeviceMatrix& mapColumns, const DeviceMatrix& previous,
+                                    AffinePositions& out) {
+  checkAffinePositionInputs(faces, base, corners, mapColumns, previous);
+  const std::size_t range = context_->info().maxStorageBufferRange;
+  const auto largest = std::max<std::size_t>({static_cast<std::size_t>(mapColumns.size()),
+                                              static_cast<std::size_t>(base.size()), corners.corners.size()});
+  if (largest > range / sizeof(double)) {  // more than one binding holds: on the host
+    Backend::affinePositions(faces, base, corners, mapColumns, previous, out);
+    return;
+  }
+  if (!affinePositions_) affinePositions_ = std::make_unique<vk::AffinePositionsKernel>(*context_);
+  affinePositions_->run(faces, base, corners, mapColumns, previous, out);
 }
 
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {

@@ -12,6 +12,7 @@ class ProjectiveFitKernel;
 class ClosestRotationsKernel;
 class IdealMapsKernel;
 class ResidentFaceMaps;
+class AffinePositionsKernel;
 }  // namespace plano::vk
 
 namespace plano::compute {
@@ -42,8 +43,12 @@ class VulkanBackend final : public Backend {
                     IdealMaps& out) override;
   /// The fits and the ideal maps stay on the device (vk::ResidentFaceMaps): three tallies
   /// come back, and the maps only when their values are read.
-  void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const Positions& target, bool similar,
+  /// A target of this backend's affinePositions is bound where it is.
+  void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target, bool similar,
                             DeviceIdealMaps& out) override;
+  /// On the device (vk::AffinePositionsKernel): two scalars come back, the positions stay.
+  void affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                       const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out) override;
   /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
@@ -72,6 +77,7 @@ class VulkanBackend final : public Backend {
   /// before the kernel, which releases it when destroyed).
   std::unique_ptr<vk::ResidentFaceMaps> residentMaps_;
   std::unique_ptr<vk::IdealMapsKernel> idealMaps_;
+  std::unique_ptr<vk::AffinePositionsKernel> affinePositions_;
 };
 
 /// Create the Vulkan backend. The device can be forced with the environment variable

@@ -386,10 +386,18 @@ void Context::countTransfer(bool upload, std::size_t bytes) {
   if (upload) {
     transfers_.uploadedBytes += bytes;
     ++transfers_.uploads;
+    transfers_.largestUpload = std::max<std::uint64_t>(transfers_.largestUpload, bytes);
   } else {
     transfers_.downloadedBytes += bytes;
     ++transfers_.downloads;
+    transfers_.largestDownload = std::max<std::uint64_t>(transfers_.largestDownload, bytes);
   }
+}
+
+void Context::resetLargestTransfers() {
+  std::lock_guard lock(allocationMutex_);
+  transfers_.largestUpload = 0;
+  transfers_.largestDownload = 0;
 }
 
 TransferCounts Context::transfers() const {

@@ -50,6 +50,10 @@ struct TransferCounts {
   std::uint64_t downloadedBytes = 0;
   std::uint64_t uploads = 0;
   std::uint64_t downloads = 0;
+  /// The largest single copy each way since the context was made or resetLargestTransfers:
+  /// whether a loop still moves a mesh-sized array, whatever its scalars add up to.
+  std::uint64_t largestUpload = 0;
+  std::uint64_t largestDownload = 0;
 };
 
 /// What the chosen device offers; kernels check it before use.
@@ -105,6 +109,8 @@ class Context {
   /// Account for one host-to-device (upload) or device-to-host copy of `bytes` bytes.
   void countTransfer(bool upload, std::size_t bytes);
   TransferCounts transfers() const;
+  /// Start TransferCounts::largestUpload and largestDownload again from zero.
+  void resetLargestTransfers();
   /// What a queue submission reports to its caller: `result`, except VK_ERROR_DEVICE_LOST
   /// from the simulated lost submission on (SimulatedFaults::deviceLostAtSubmit).
   VkResult submissionResult(VkResult result);

@@ -134,7 +134,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
   checkMeshFitsOneBinding(faces, static_cast<Index>(source.rows()), range);
   source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
   // Without a target the shader never reads its binding, which still needs a buffer.
-  if (!target) residentTarget = nullptr;
+  const bool hasTarget = target || residentTarget;
   if (!residentTarget) {
     ensureCapacity(target_, context_, target ? static_cast<std::size_t>(target->size()) : 1, "target positions");
     if (target) target_.upload({target->data(), static_cast<std::size_t>(target->size())});
@@ -153,7 +153,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
   ensureCapacity(methods_, context_, chunk, "ideal map methods");
   DescriptorSet set(context_, pipeline_,
                     {BufferRange(source_.array(), 0, positionBytes),
-                     BufferRange(targetArray, 0, target ? positionBytes : sizeof(double)),
+                     BufferRange(targetArray, 0, hasTarget ? positionBytes : sizeof(double)),
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
                      BufferRange(fittedArray, 0, chunk * kMapBytes), BufferRange(ideal_, 0, chunk * kMapBytes),
                      BufferRange(methods_, 0, chunk * sizeof(std::int32_t))});
@@ -172,7 +172,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
     sequence.begin();
     if (kept) sequence.zero(tallies_, 3 * sizeof(std::uint32_t));
     sequence.dispatch(pipeline_, set,
-                      IdealMapsPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), target ? 1u : 0u,
+                      IdealMapsPush{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(n), hasTarget ? 1u : 0u,
                            similar ? 1u : 0u},
                       groupsFor(context_, n));
     if (kept) {
@@ -199,16 +199,19 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
 }
 
 void IdealMapsKernel::keepOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
-                                         const Positions& target, const Array<double>* residentTarget, bool similar,
+                                         const Positions* target, const Array<double>* residentTarget, bool similar,
                                          compute::DeviceIdealMaps& out) {
-  compute::checkFitInputs(source, target);
+  if (target) compute::checkFitInputs(source, *target);
+  if (!target && (!residentTarget || residentTarget->count() < static_cast<std::size_t>(source.size()))) {
+    throwUsage("closestIdealMaps: no target positions for the kept maps' corner fallback");
+  }
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   if (fitted.count() < faceCount * 16 || faceCount > context_.info().maxStorageBufferRange / kMapBytes) {
     throwUsage("closestIdealMaps: the resident fits do not hold the maps of all " + std::to_string(faceCount) +
                " faces in one binding");
   }
   compute::IdealMaps unused;
-  mapChunks(faces, source, {}, &target, similar, unused, &fitted, residentTarget, &out);
+  mapChunks(faces, source, {}, target, similar, unused, &fitted, residentTarget, &out);
 }
 
 }  // namespace plano::vk

@@ -78,8 +78,9 @@ class IdealMapsKernel {
   /// runOnResidentFits that leaves the maps on the device (compute::Backend::
   /// fitIdealMapsOnDevice): only the methods' tallies (shaders/ideal_map_tally.comp, 12
   /// bytes) come back. Needs the kernel's resident record (Error(Usage) without one).
+  /// `target` may be null when `residentTarget` holds the positions.
   void keepOnResidentFits(const FaceList& faces, const Positions& source, const Array<double>& fitted,
-                          const Positions& target, const Array<double>* residentTarget, bool similar,
+                          const Positions* target, const Array<double>* residentTarget, bool similar,
                           compute::DeviceIdealMaps& out);
 
  private:

@@ -30,17 +30,25 @@ ProjectiveFitKernel::ProjectiveFitKernel(Context& context, ProjectiveFitSettings
 
 void ProjectiveFitKernel::run(const FaceList& faces, const Positions& source, const Positions& target,
                               compute::ProjectiveFits& out) {
-  fit(faces, source, target, &out);
+  fit(faces, source, &target, nullptr, &out);
 }
 
 const Array<double>* ProjectiveFitKernel::runResident(const FaceList& faces, const Positions& source,
                                                       const Positions& target) {
-  return fit(faces, source, target, nullptr) ? &maps_ : nullptr;
+  return fit(faces, source, &target, nullptr, nullptr) ? &maps_ : nullptr;
 }
 
-bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, const Positions& target,
-                              compute::ProjectiveFits* out) {
-  compute::checkFitInputs(source, target);
+const Array<double>* ProjectiveFitKernel::runResidentOn(const FaceList& faces, const Positions& source,
+                                                        const Array<double>& target) {
+  if (target.count() < static_cast<std::size_t>(source.size())) {
+    throwUsage("fitProjectiveMaps: the device's target positions are fewer than the source's");
+  }
+  return fit(faces, source, nullptr, &target, nullptr) ? &maps_ : nullptr;
+}
+
+bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, const Positions* target,
+                              const Array<double>* residentTarget, compute::ProjectiveFits* out) {
+  if (target) compute::checkFitInputs(source, *target);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   if (out) {
     out->maps.resize(faceCount);
@@ -73,7 +81,8 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
   if (!out && chunkEnds.size() > 1) return false;
 
   source_.assign(context_, {source.data(), static_cast<std::size_t>(source.size())}, "source positions");
-  target_.assign(context_, {target.data(), static_cast<std::size_t>(target.size())}, "target positions");
+  if (target) target_.assign(context_, {target->data(), static_cast<std::size_t>(target->size())}, "target positions");
+  const Array<double>& targetArray = target ? target_.array() : *residentTarget;
   offsets_.assign(context_, faces.offsets(), "face offsets");
   indices_.assign(context_, faces.indices(), "face corners");
   ensureCapacity(maps_, context_, maxFaces * 16, "projective maps");
@@ -81,7 +90,7 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
   ensureCapacity(residuals_, context_, maxFaces, "fit residuals");
   ensureCapacity(ranks_, context_, maxFaces, "fit ranks");
   DescriptorSet set(context_, pipeline_,
-                    {BufferRange(source_.array(), 0, positionBytes), BufferRange(target_.array(), 0, positionBytes),
+                    {BufferRange(source_.array(), 0, positionBytes), BufferRange(targetArray, 0, positionBytes),
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
                      BufferRange(maps_, 0, maxFaces * kMapBytes),
                      BufferRange(scales_, 0, maxCorners * sizeof(double)),

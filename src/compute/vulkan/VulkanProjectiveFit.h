@@ -27,6 +27,9 @@ class ProjectiveFitKernel {
   /// run, when the maps need more than one storage binding (then use run()). The fits of
   /// no face count as resident (`mapsHolding` holds nothing after it).
   const Array<double>* runResident(const FaceList& faces, const Positions& source, const Positions& target);
+  /// runResident with the target positions in a device array of this context (#V x 3,
+  /// row-major: vk::AffinePositionsKernel's), bound instead of uploaded.
+  const Array<double>* runResidentOn(const FaceList& faces, const Positions& source, const Array<double>& target);
 
   /// The device array of the last run's maps (16 doubles a face, column-major) when it
   /// holds exactly `maps` (a run of one chunk), else null; and that of its targets when
@@ -37,7 +40,10 @@ class ProjectiveFitKernel {
 
  private:
   /// run() with `out`, runResident() without (false: more than one chunk, nothing run).
-  bool fit(const FaceList& faces, const Positions& source, const Positions& target, compute::ProjectiveFits* out);
+  /// The target as host positions (`target`) or a device array (`residentTarget`, when
+  /// `target` is null).
+  bool fit(const FaceList& faces, const Positions& source, const Positions* target,
+           const Array<double>* residentTarget, compute::ProjectiveFits* out);
 
   Context& context_;
   ProjectiveFitSettings settings_;

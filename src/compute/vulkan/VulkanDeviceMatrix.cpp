@@ -1,0 +1,44 @@
+#include "compute/vulkan/VulkanDeviceMatrix.h"
+
+#include <vector>
+
+#include "core/Error.h"
+
+namespace plano::vk {
+
+ArraySource::ArraySource(const Context& context, const Array<double>& array, ArrayLayout layout, Eigen::Index rows,
+                         Eigen::Index cols, std::uint64_t generation, std::weak_ptr<const std::uint64_t> live)
+    : context_(context), array_(array), layout_(layout), rows_(rows), cols_(cols), generation_(generation),
+      live_(std::move(live)) {}
+
+bool ArraySource::current() const {
+  const auto live = live_.lock();
+  return live && *live == generation_;
+}
+
+void ArraySource::fetch(Eigen::MatrixXd& out) const {
+  if (!current()) {
+    throwUsage("device matrix: its device array was rewritten (or freed) before its values were read");
+  }
+  std::vector<double> values(static_cast<std::size_t>(rows_ * cols_));
+  if (!values.empty()) array_.download(values);
+  out.resize(rows_, cols_);
+  if (layout_ == ArrayLayout::ColumnMajor) {
+    out = Eigen::Map<const Eigen::MatrixXd>(values.data(), rows_, cols_);
+  } else {
+    out = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(),
+                                                                                                 rows_, cols_);
+  }
+}
+
+const Array<double>* ArraySource::arrayIn(const Context& context) const {
+  return &context == &context_ && current() ? &array_ : nullptr;
+}
+
+const Array<double>* arrayOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout) {
+  const auto* source = dynamic_cast<const ArraySource*>(m.source());
+  if (!source || source->layout() != layout || m.factor() != 1.0) return nullptr;
+  return source->arrayIn(context);
+}
+
+}  // namespace plano::vk

@@ -1,0 +1,43 @@
+#pragma once
+// The sources of the device matrices (compute::DeviceMatrix) whose values one device array
+// holds: kernels of the same context bind that array instead of uploading the values.
+#include <cstdint>
+#include <memory>
+
+#include "compute/DeviceMatrix.h"
+#include "compute/vulkan/VulkanBuffer.h"
+
+namespace plano::vk {
+
+/// How an array holds a rows x cols matrix.
+enum class ArrayLayout {
+  ColumnMajor,  ///< Entry (r, c) at c * rows + r (DeviceVectors: the ADMM's x).
+  RowMajor,     ///< Entry (r, c) at r * cols + c (vertex positions, as Positions).
+};
+
+/// A device matrix's values in one array of a context, valid while the array's owner keeps
+/// the generation the source was made for (watched weakly: the owner may be gone).
+class ArraySource final : public compute::DeviceMatrixSource {
+ public:
+  ArraySource(const Context& context, const Array<double>& array, ArrayLayout layout, Eigen::Index rows,
+              Eigen::Index cols, std::uint64_t generation, std::weak_ptr<const std::uint64_t> live);
+  void fetch(Eigen::MatrixXd& out) const override;
+  /// The array when it still holds the values and belongs to `context`; else null.
+  const Array<double>* arrayIn(const Context& context) const;
+  ArrayLayout layout() const { return layout_; }
+
+ private:
+  bool current() const;
+  const Context& context_;
+  const Array<double>& array_;
+  ArrayLayout layout_;
+  Eigen::Index rows_, cols_;
+  std::uint64_t generation_;
+  std::weak_ptr<const std::uint64_t> live_;
+};
+
+/// The array of `m` when its source is an ArraySource of `context` in `layout`, still
+/// current, with factor 1; else null.
+const Array<double>* arrayOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout);
+
+}  // namespace plano::vk
