@@ -70,7 +70,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
   // Phase 1's positions, normalized, where the backend computes them: on a device the loop
   // below moves no mesh-sized data between host and device (the ideal maps, the global
   // step's solution and these positions stay there; scalars come back).
-  compute::DeviceMatrix current(Eigen::MatrixXd(space_.normalization().toNormalized(positions)));
+  compute::DeviceMatrix current(Eigen::MatrixXd(normalizedTargetPositions(space_, positions)));
   bool currentIsNewer = false;  // `current` holds positions that `positions` does not yet
   const compute::VertexCorners corners = space_.vertexCorners();
   try {

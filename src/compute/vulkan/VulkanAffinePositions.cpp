@@ -79,8 +79,8 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   if (!distance_ || distance_->n() != vertexCount) {
     distance_ = std::make_unique<DeviceVectors>(context_, vertexCount, 1, "vertex displacements");
   }
-  if (!planarity_values_ || planarity_values_->n() != faceCount) {
-    planarity_values_ = std::make_unique<DeviceVectors>(context_, std::max<std::uint32_t>(faceCount, 1), 1,
+  if (!planarityValues_ || planarityValues_->n() != faceCount) {
+    planarityValues_ = std::make_unique<DeviceVectors>(context_, std::max<std::uint32_t>(faceCount, 1), 1,
                                                         "face planarity");
   }
   if (!measures_) measures_ = std::make_unique<DeviceScalars>(context_, 2, 1, std::max(vertexCount, faceCount));
@@ -97,12 +97,12 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   if (faceCount > 0) {
     s.dispatch(planarity_,
                {BufferRange(output, 0, positionCount * sizeof(double)), BufferRange(faceOffsets_.array()),
-                BufferRange(faceCorners_.array()), BufferRange(planarity_values_->data())},
+                BufferRange(faceCorners_.array()), BufferRange(planarityValues_->data())},
                FacePlanarityPush{0, faceCount}, groupsFor(context_, faceCount));
     s.barrier();
   }
   algebra_.maxAbs(s, *distance_, *measures_, 0);
-  if (faceCount > 0) algebra_.maxAbs(s, *planarity_values_, *measures_, 1);
+  if (faceCount > 0) algebra_.maxAbs(s, *planarityValues_, *measures_, 1);
   s.end();
   s.run();
   const std::vector<double> measured = measures_->read();

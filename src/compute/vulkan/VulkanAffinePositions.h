@@ -39,7 +39,7 @@ class AffinePositionsKernel {
   Array<double> outputs_[2];
   std::shared_ptr<std::uint64_t> generations_[2];
   int next_ = 0;
-  std::unique_ptr<DeviceVectors> distance_, planarity_values_;
+  std::unique_ptr<DeviceVectors> distance_, planarityValues_;
   std::unique_ptr<DeviceScalars> measures_;
 };
 
