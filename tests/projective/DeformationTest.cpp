@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
 #include "support/TestMeshes.h"
@@ -119,6 +123,22 @@ TEST_F(DeformationTest, SolverIsReusableWithMovedHandles) {
   const DeformationInfo info = deformation.solve(handles, positions);
   EXPECT_EQ(info.status, DeformationStatus::Converged);
   EXPECT_LT((positions.row(c.constraints.handles[0].vertex) - handles.row(0)).norm(), 1e-9);
+}
+
+TEST_F(DeformationTest, NonFiniteStartingPositionsAreABadInputErrorNamingTheVertex) {
+  const GridCase c = gridCase(3, {0.0, 0.0, 0.2});
+  Deformation deformation(backend, c.mesh, c.constraints);
+  Positions handles(1, 3);
+  handles.row(0) = c.constraints.handles[0].position.transpose();
+  Positions positions = c.mesh.vertices;
+  positions(5, 1) = std::nan("");
+  try {
+    deformation.solve(handles, positions);
+    ADD_FAILURE() << "expected Error(BadInput)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput);
+    EXPECT_NE(std::string(e.what()).find("vertex 5 "), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(DeformationTest, GitterMeshKeepsItsPlanarity) {
