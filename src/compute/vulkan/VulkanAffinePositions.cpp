@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "compute/vulkan/VulkanFacePlanarity.h"
 #include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
@@ -15,12 +16,7 @@ struct AffinePositionsPush {
   std::uint32_t rows;
 };
 
-struct FacePlanarityPush {
-  std::uint32_t firstFace;
-  std::uint32_t faceCount;
-};
-
-std::span<const double> valuesOf(const Positions& positions) {
+std::span<const double> positionValues(const Positions& positions) {
   return {positions.data(), static_cast<std::size_t>(positions.size())};
 }
 
@@ -49,7 +45,7 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   checkMeshFitsOneBinding(faces, static_cast<Index>(base.rows()), context_.info().maxStorageBufferRange);
   const std::size_t positionCount = std::size_t{vertexCount} * 3;
 
-  base_.assign(context_, valuesOf(base), "base positions");
+  base_.assign(context_, positionValues(base), "base positions");
   vertexOffsets_.assign(context_, {corners.offsets.data(), corners.offsets.size()}, "vertex corner offsets");
   vertexCorners_.assign(context_, {corners.corners.data(), corners.corners.size()}, "vertex corners");
   cornerFace_.assign(context_, {corners.cornerFace.data(), corners.cornerFace.size()}, "corner faces");
@@ -69,7 +65,7 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   if (!before) {
     const Positions values = previous.values();
     ensureCapacity(uploadedPrevious_, context_, positionCount, "previous positions");
-    uploadedPrevious_.upload(valuesOf(values));
+    uploadedPrevious_.upload(positionValues(values));
     before = &uploadedPrevious_;
   }
 

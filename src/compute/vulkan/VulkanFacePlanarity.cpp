@@ -7,14 +7,6 @@
 #include "core/Error.h"
 
 namespace plano::vk {
-namespace {
-
-struct FacePlanarityPush {
-  std::uint32_t firstFace;
-  std::uint32_t faceCount;
-};
-
-}  // namespace
 
 FacePlanarityKernel::FacePlanarityKernel(Context& context)
     : context_(context), pipeline_(context, "face_planarity", 4, sizeof(FacePlanarityPush)) {}

@@ -1,12 +1,19 @@
 #pragma once
 // Per-face planarity on the device (shaders/face_planarity.comp), the definition of
 // src/mesh/Planarity.h, double precision.
+#include <cstdint>
 #include <span>
 
 #include "compute/vulkan/VulkanSequence.h"
 #include "mesh/PolygonMesh.h"
 
 namespace plano::vk {
+
+/// shaders/face_planarity.comp's push constants (its other users record it too).
+struct FacePlanarityPush {
+  std::uint32_t firstFace;
+  std::uint32_t faceCount;
+};
 
 class FacePlanarityKernel {
  public:
