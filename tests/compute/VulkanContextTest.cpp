@@ -7,17 +7,12 @@
 #include <vector>
 
 #include "compute/vulkan/VulkanBuffer.h"
+#include "compute/VulkanFixture.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "core/Error.h"
 
 namespace plano::test {
 namespace {
-
-vk::ContextSettings validatedSettings() {
-  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
-  settings.validation = true;
-  return settings;
-}
 
 TEST(VulkanContext, ReportsDoublePrecisionAndLimits) {
   vk::Context context(validatedSettings());

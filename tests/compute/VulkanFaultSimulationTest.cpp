@@ -8,6 +8,7 @@
 
 #include "compute/vulkan/VulkanBackend.h"
 #include "compute/vulkan/VulkanBuffer.h"
+#include "compute/VulkanFixture.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "core/Error.h"
 #include "mesh/Generators.h"
@@ -15,12 +16,6 @@
 
 namespace plano::test {
 namespace {
-
-vk::ContextSettings validatedSettings() {
-  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
-  settings.validation = true;
-  return settings;
-}
 
 /// The message of the Error(Device) that `action` throws; fails the test otherwise.
 template <class Action>

@@ -14,6 +14,13 @@ namespace plano::test {
 /// creation failed (the reason is in *error).
 compute::VulkanBackend* sharedVulkanBackend(std::string* error);
 
+/// Settings of a context of its own (PLANO_VULKAN_DEVICE honoured) with the validation layers on.
+inline vk::ContextSettings validatedSettings() {
+  vk::ContextSettings settings = vk::ContextSettings::fromEnvironment(vk::DeviceSelection::Any);
+  settings.validation = true;
+  return settings;
+}
+
 class VulkanTest : public ::testing::Test {
  protected:
   void SetUp() override;

@@ -75,7 +75,7 @@ void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions&
                                          bool similar, DeviceIdealMaps& out) {
   if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
-  const bool oneBinding = faceCount <= context_->info().maxStorageBufferRange / (16 * sizeof(double));
+  const bool oneBinding = faceCount <= context_->info().maxStorageBufferRange / vk::kFaceMapBytes;
   // Positions this backend computed (affinePositions) are bound where they are.
   const vk::Array<double>* residentTarget =
       target.rows() == source.rows() && target.cols() == 3 ? vk::arrayOf(target, *context_, vk::ArrayLayout::RowMajor)

@@ -1,6 +1,7 @@
 #pragma once
 // The sources of the device matrices (compute::DeviceMatrix) whose values one device array
 // holds: kernels of the same context bind that array instead of uploading the values.
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -8,6 +9,9 @@
 #include "compute/vulkan/VulkanBuffer.h"
 
 namespace plano::vk {
+
+/// One face map in a device array: 16 doubles, column-major (the fit and ideal-map kernels').
+inline constexpr std::size_t kFaceMapBytes = 16 * sizeof(double);
 
 /// How an array holds a rows x cols matrix.
 enum class ArrayLayout {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanDeviceMatrix.h"
 #include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
@@ -19,7 +20,6 @@ struct IdealMapsPush {
 static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 16 packed doubles");
 static_assert(sizeof(compute::IdealMapMethod) == sizeof(std::int32_t), "methods are 32-bit on the device");
 
-constexpr std::size_t kMapBytes = 16 * sizeof(double);
 
 }  // namespace
 
@@ -37,7 +37,7 @@ class ResidentFaceMaps::ColumnsSource final : public compute::DeviceMatrixSource
       throwUsage("ideal maps on the device: they were overwritten (or the backend destroyed) before they were read");
     }
     std::vector<Eigen::Matrix4d> maps(faceCount_);
-    array_->Buffer::download(maps.data(), faceCount_ * kMapBytes);
+    array_->Buffer::download(maps.data(), faceCount_ * kFaceMapBytes);
     out.resize(4 * static_cast<Eigen::Index>(faceCount_), 3);
     for (std::size_t f = 0; f < faceCount_; ++f) out.middleRows<4>(4 * static_cast<Eigen::Index>(f)) = maps[f].leftCols<3>();
   }
@@ -110,7 +110,7 @@ void IdealMapsKernel::runOnResidentFits(const FaceList& faces, const Positions& 
   compute::checkFitInputs(source, target);  // the positions the fits were made to
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   const std::size_t range = context_.info().maxStorageBufferRange;
-  if (fitted.count() < faceCount * 16 || faceCount > range / kMapBytes) {
+  if (fitted.count() < faceCount * 16 || faceCount > range / kFaceMapBytes) {
     throwUsage("closestIdealMaps: the resident fits do not hold the maps of all " + std::to_string(faceCount) +
                " faces in one binding");
   }
@@ -145,7 +145,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
 
   // Faces per chunk: the fitted and the ideal maps (128 bytes a face each) must fit one
   // storage binding.
-  const std::size_t chunk = std::min(faceCount, range / kMapBytes);
+  const std::size_t chunk = std::min(faceCount, range / kFaceMapBytes);
   if (chunk < faceCount || (residentFitted && residentFitted->count() < faceCount * 16)) residentFitted = nullptr;
   if (!residentFitted) ensureCapacity(fitted_, context_, chunk * 16, "fitted maps");
   const Array<double>& fittedArray = residentFitted ? *residentFitted : fitted_;
@@ -155,7 +155,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
                     {BufferRange(source_.array(), 0, positionBytes),
                      BufferRange(targetArray, 0, hasTarget ? positionBytes : sizeof(double)),
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
-                     BufferRange(fittedArray, 0, chunk * kMapBytes), BufferRange(ideal_, 0, chunk * kMapBytes),
+                     BufferRange(fittedArray, 0, chunk * kFaceMapBytes), BufferRange(ideal_, 0, chunk * kFaceMapBytes),
                      BufferRange(methods_, 0, chunk * sizeof(std::int32_t))});
   if (kept && (chunk < faceCount || !resident_)) {
     throwUsage("closestIdealMaps: the ideal maps of " + std::to_string(faceCount) +
@@ -168,7 +168,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
   Sequence sequence(context_);
   for (std::size_t first = 0; first < faceCount; first += chunk) {
     const std::size_t n = std::min(chunk, faceCount - first);
-    if (!residentFitted) fitted_.Buffer::upload(fitted.data() + first, n * kMapBytes);
+    if (!residentFitted) fitted_.Buffer::upload(fitted.data() + first, n * kFaceMapBytes);
     sequence.begin();
     if (kept) sequence.zero(tallies_, 3 * sizeof(std::uint32_t));
     sequence.dispatch(pipeline_, set,
@@ -184,7 +184,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
     sequence.end();
     sequence.run();
     if (kept) break;  // one chunk
-    ideal_.Buffer::download(out.maps.data() + first, n * kMapBytes);
+    ideal_.Buffer::download(out.maps.data() + first, n * kFaceMapBytes);
     methods_.Buffer::download(out.methods.data() + first, n * sizeof(std::int32_t));
   }
   if (!resident_ || chunk < faceCount) return;
@@ -206,7 +206,7 @@ void IdealMapsKernel::keepOnResidentFits(const FaceList& faces, const Positions&
     throwUsage("closestIdealMaps: no target positions for the kept maps' corner fallback");
   }
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
-  if (fitted.count() < faceCount * 16 || faceCount > context_.info().maxStorageBufferRange / kMapBytes) {
+  if (fitted.count() < faceCount * 16 || faceCount > context_.info().maxStorageBufferRange / kFaceMapBytes) {
     throwUsage("closestIdealMaps: the resident fits do not hold the maps of all " + std::to_string(faceCount) +
                " faces in one binding");
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "compute/vulkan/VulkanDeviceMatrix.h"
 #include "compute/vulkan/VulkanInputChecks.h"
 #include "core/Error.h"
 
@@ -18,7 +19,6 @@ struct ProjectiveFitPush {
 static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 16 packed doubles");
 static_assert(sizeof(int) == sizeof(std::int32_t), "ranks are 32-bit on the device");
 
-constexpr std::size_t kMapBytes = 16 * sizeof(double);
 // Workgroup size of shaders/projective_fit.comp (FIT_GROUP_SIZE).
 constexpr std::uint32_t kFitGroupSize = 64;
 
@@ -67,7 +67,7 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
   // Faces per chunk: the maps (128 bytes a face) and the chunk's corner scales must each
   // fit one storage binding.
   const std::vector<Index>& offset = faces.offsets();
-  const std::size_t maxFaces = std::min(faceCount, range / kMapBytes);
+  const std::size_t maxFaces = std::min(faceCount, range / kFaceMapBytes);
   std::vector<std::size_t> chunkEnds;
   std::size_t maxCorners = 0;
   for (std::size_t first = 0; first < faceCount;) {
@@ -92,7 +92,7 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
   DescriptorSet set(context_, pipeline_,
                     {BufferRange(source_.array(), 0, positionBytes), BufferRange(targetArray, 0, positionBytes),
                      BufferRange(offsets_.array()), BufferRange(indices_.array()),
-                     BufferRange(maps_, 0, maxFaces * kMapBytes),
+                     BufferRange(maps_, 0, maxFaces * kFaceMapBytes),
                      BufferRange(scales_, 0, maxCorners * sizeof(double)),
                      BufferRange(residuals_, 0, maxFaces * sizeof(double)),
                      BufferRange(ranks_, 0, maxFaces * sizeof(std::int32_t))});
@@ -107,7 +107,7 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
     sequence.end();
     sequence.run();
     if (out) {
-      maps_.Buffer::download(out->maps.data() + first, n * kMapBytes);
+      maps_.Buffer::download(out->maps.data() + first, n * kFaceMapBytes);
       scales_.download(std::span<double>(out->reciprocalScales).subspan(offset[first], offset[last] - offset[first]));
       residuals_.download(std::span<double>(out->residuals).subspan(first, n));
       ranks_.download(std::span<std::int32_t>(out->ranks.data() + first, n));
