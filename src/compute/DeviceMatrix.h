@@ -22,7 +22,8 @@ class DeviceMatrixSource {
 
 class DeviceMatrix {
  public:
-  DeviceMatrix() = default;
+  /// 0 x 0 values on the host.
+  DeviceMatrix() : host_(std::in_place) {}
   /// Values on the host (implicit: every function that takes a DeviceMatrix takes an
   /// Eigen matrix as before).
   DeviceMatrix(Eigen::MatrixXd values);  // NOLINT(google-explicit-constructor)
