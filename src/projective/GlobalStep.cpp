@@ -20,6 +20,12 @@ std::string formatDouble(double value) {
   return s.str();
 }
 
+/// maps = one per four rows of x (4 #F x 3), their first three columns those rows.
+void setFirstColumns(const Eigen::MatrixXd& x, std::vector<Eigen::Matrix4d>& maps) {
+  maps.resize(static_cast<std::size_t>(x.rows() / 4));
+  for (std::size_t f = 0; f < maps.size(); ++f) maps[f].leftCols<3>() = x.middleRows<4>(4 * static_cast<Eigen::Index>(f));
+}
+
 }  // namespace
 
 const char* toString(GlobalStepStatus status) {
@@ -118,12 +124,8 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   compute::DeviceMatrix columns;
   GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), shat, positions, columns);
   info.nonPositiveScales = nonPositive;
-  const Eigen::MatrixXd& x = columns.values();
-  result.maps.resize(faceCount);
-  for (Index f = 0; f < faceCount; ++f) {
-    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
-    result.maps[f].col(3) = targets[f].col(3);
-  }
+  setFirstColumns(columns.values(), result.maps);
+  for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = targets[f].col(3);
   result.reciprocalScales = std::move(shat);
   return info;
 }
@@ -132,13 +134,8 @@ GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumn
                                        FaceMaps& result) {
   compute::DeviceMatrix columns;
   const GlobalStepInfo info = solveAffine(linearColumns, positions, columns);
-  const Eigen::MatrixXd& x = columns.values();
-  const Index faceCount = space_.faceCount();
-  result.maps.resize(faceCount);
-  for (Index f = 0; f < faceCount; ++f) {
-    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
-    result.maps[f].col(3) = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
-  }
+  setFirstColumns(columns.values(), result.maps);
+  for (auto& map : result.maps) map.col(3) = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
   result.reciprocalScales.assign(space_.cornerCount(), 1.0);
   return info;
 }

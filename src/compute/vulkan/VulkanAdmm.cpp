@@ -405,13 +405,12 @@ AdmmKernels::~AdmmKernels() = default;
 
 void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   if (equality.size() != m_) throwUsage("ADMM: equality flags for " + std::to_string(equality.size()) + " rows");
-  // A new equality pattern (at most once per solve) or new values of C change K1 = C^T D C
-  // and its coarse levels: assembled on the device from the row scales D, the only
-  // mesh-sized upload here. A rho update alone moves no mesh-sized data: K, the per-row
-  // penalties and the preconditioner's blocks are recomputed on the device; one flag
-  // comes back.
-  // D of an unchanged pattern is kept on the device: K1 formed again after a polish (whose
-  // flags replaced the row scales) or for new values of C copies it there.
+  // A new equality pattern (at most once per solve), new values of C or a polish (whose
+  // flags replaced the row scales) change K1 = C^T D C and its coarse levels: assembled on
+  // the device from the row scales D, which are uploaded only for a new pattern (kept on the
+  // device otherwise, and copied into place). A rho update alone moves no mesh-sized data:
+  // K, the per-row penalties and the preconditioner's blocks are recomputed on the device;
+  // one flag comes back.
   if (!k1Current_ || equality != equality_) {
     if (equality != equality_ || !admmRowScalesHeld_) {
       admmRowScalesHeld_ = false;

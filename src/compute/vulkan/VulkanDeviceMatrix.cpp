@@ -20,14 +20,21 @@ void ArraySource::fetch(Eigen::MatrixXd& out) const {
   if (!current()) {
     throwUsage("device matrix: its device array was rewritten (or freed) before its values were read");
   }
-  std::vector<double> values(static_cast<std::size_t>(rows_ * cols_));
+  const Eigen::Index stored = layout_ == ArrayLayout::FaceMapColumns ? 4 * rows_ : rows_ * cols_;
+  std::vector<double> values(static_cast<std::size_t>(stored));
   if (!values.empty()) array_.download(values);
   out.resize(rows_, cols_);
-  if (layout_ == ArrayLayout::ColumnMajor) {
-    out = Eigen::Map<const Eigen::MatrixXd>(values.data(), rows_, cols_);
-  } else {
-    out = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(),
-                                                                                                 rows_, cols_);
+  switch (layout_) {
+    case ArrayLayout::ColumnMajor: out = Eigen::Map<const Eigen::MatrixXd>(values.data(), rows_, cols_); break;
+    case ArrayLayout::RowMajor:
+      out = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(),
+                                                                                                   rows_, cols_);
+      break;
+    case ArrayLayout::FaceMapColumns:
+      for (Eigen::Index f = 0; 4 * f < rows_; ++f) {
+        out.middleRows<4>(4 * f) = Eigen::Map<const Eigen::Matrix4d>(values.data() + 16 * f).leftCols(cols_);
+      }
+      break;
   }
 }
 

@@ -17,6 +17,9 @@ inline constexpr std::size_t kFaceMapBytes = 16 * sizeof(double);
 enum class ArrayLayout {
   ColumnMajor,  ///< Entry (r, c) at c * rows + r (DeviceVectors: the ADMM's x).
   RowMajor,     ///< Entry (r, c) at r * cols + c (vertex positions, as Positions).
+  /// The first three columns of 4x4 face maps stored 16 doubles a face, column-major:
+  /// entry (4 f + r, c) at 16 f + 4 c + r (the ideal-map kernel's array; rows = 4 #F, cols 3).
+  FaceMapColumns,
 };
 
 /// A device matrix's values in one array of a context, valid while the array's owner keeps

@@ -20,38 +20,11 @@ struct IdealMapsPush {
 static_assert(sizeof(Eigen::Matrix4d) == 16 * sizeof(double), "Matrix4d must be 16 packed doubles");
 static_assert(sizeof(compute::IdealMapMethod) == sizeof(std::int32_t), "methods are 32-bit on the device");
 
-
 }  // namespace
 
-class ResidentFaceMaps::ColumnsSource final : public compute::DeviceMatrixSource {
- public:
-  ColumnsSource(const ResidentFaceMaps& record)
-      : array_(record.array_),
-        faceCount_(record.faceCount_),
-        generation_(record.generation_),
-        live_(record.liveGeneration_) {}
-
-  void fetch(Eigen::MatrixXd& out) const override {
-    const auto live = live_.lock();
-    if (!live || *live != generation_) {
-      throwUsage("ideal maps on the device: they were overwritten (or the backend destroyed) before they were read");
-    }
-    std::vector<Eigen::Matrix4d> maps(faceCount_);
-    array_->Buffer::download(maps.data(), faceCount_ * kFaceMapBytes);
-    out.resize(4 * static_cast<Eigen::Index>(faceCount_), 3);
-    for (std::size_t f = 0; f < faceCount_; ++f) out.middleRows<4>(4 * static_cast<Eigen::Index>(f)) = maps[f].leftCols<3>();
-  }
-
-  bool holds(const ResidentFaceMaps& record) const { return record.array_ && record.generation_ == generation_; }
-
- private:
-  const Array<double>* array_;
-  std::size_t faceCount_;
-  std::uint64_t generation_;
-  std::weak_ptr<const std::uint64_t> live_;
-};
-
-void ResidentFaceMaps::hold(const Array<double>& array, std::size_t faceCount, std::vector<Eigen::Matrix4d> maps) {
+void ResidentFaceMaps::hold(const Context& context, const Array<double>& array, std::size_t faceCount,
+                            std::vector<Eigen::Matrix4d> maps) {
+  context_ = &context;
   array_ = &array;
   faceCount_ = faceCount;
   maps_ = std::move(maps);
@@ -79,14 +52,17 @@ const Array<double>* ResidentFaceMaps::holdingNegatedColumns(const Eigen::Matrix
 }
 
 const Array<double>* ResidentFaceMaps::holdingColumns(const compute::DeviceMatrix& m, double factor) const {
-  if (!array_ || !source_ || m.source() != source_.get() || m.factor() != factor) return nullptr;
-  if (m.rows() != 4 * static_cast<Eigen::Index>(faceCount_) || m.cols() != 3 || !source_->holds(*this)) return nullptr;
-  return array_;
+  // source_ is this generation's (hold and release reset it).
+  return source_ && m.source() == source_.get() && m.factor() == factor ? array_ : nullptr;
 }
 
 std::shared_ptr<const compute::DeviceMatrixSource> ResidentFaceMaps::columnsSource() const {
   if (!array_) throwUsage("ideal maps on the device: none are held");
-  if (!source_) source_ = std::make_shared<const ColumnsSource>(*this);
+  if (!source_) {
+    source_ = std::make_shared<const ArraySource>(*context_, *array_, ArrayLayout::FaceMapColumns,
+                                                  4 * static_cast<Eigen::Index>(faceCount_), 3, generation_,
+                                                  liveGeneration_);
+  }
   return source_;
 }
 
@@ -188,7 +164,7 @@ void IdealMapsKernel::mapChunks(const FaceList& faces, const Positions& source, 
     methods_.Buffer::download(out.methods.data() + first, n * sizeof(std::int32_t));
   }
   if (!resident_ || chunk < faceCount) return;
-  resident_->hold(ideal_, faceCount, kept ? std::vector<Eigen::Matrix4d>{} : out.maps);  // ideal_ holds them all
+  resident_->hold(context_, ideal_, faceCount, kept ? std::vector<Eigen::Matrix4d>{} : out.maps);  // ideal_ holds them all
   if (!kept) return;
   std::uint32_t tally[3] = {};
   tallies_.download({tally, 3});

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "compute/Backend.h"
+#include "compute/vulkan/VulkanDeviceMatrix.h"
 #include "compute/vulkan/VulkanSequence.h"
 
 namespace plano::vk {
@@ -23,27 +24,29 @@ class ResidentFaceMaps {
  public:
   /// `array` holds the maps of `faceCount` faces now (until the next hold or release);
   /// `maps` is their host copy, or empty when they were not downloaded.
-  void hold(const Array<double>& array, std::size_t faceCount, std::vector<Eigen::Matrix4d> maps);
+  void hold(const Context& context, const Array<double>& array, std::size_t faceCount,
+            std::vector<Eigen::Matrix4d> maps);
   void release();
   /// The array when `q` (n x k, k <= 4) is, entry for entry, minus the first k columns of
   /// the held maps stacked four rows a face (q(4 f + r, c) = -M_f(r, c)); else null.
   const Array<double>* holdingNegatedColumns(const Eigen::MatrixXd& q) const;
   /// The array when `m` is `factor` times columnsSource()'s matrix of the maps held now.
   const Array<double>* holdingColumns(const compute::DeviceMatrix& m, double factor) const;
-  /// The held maps' first three columns (4 #F x 3) as a device matrix's source: fetched
-  /// from the array while this record holds them (Error(Usage) after).
+  /// The held maps' first three columns (4 #F x 3) as a device matrix's source
+  /// (ArrayLayout::FaceMapColumns): fetched from the array while this record holds them
+  /// (Error(Usage) after).
   std::shared_ptr<const compute::DeviceMatrixSource> columnsSource() const;
   std::uint64_t generation() const { return generation_; }
 
  private:
-  class ColumnsSource;
+  const Context* context_ = nullptr;
   const Array<double>* array_ = nullptr;
   std::size_t faceCount_ = 0;
   std::vector<Eigen::Matrix4d> maps_;
   std::uint64_t generation_ = 0;  ///< Changes with every hold and release.
   /// The source of the current generation (made on first request; one per generation, so
-  /// that q = -T and x = T of one step share it).
-  mutable std::shared_ptr<const ColumnsSource> source_;
+  /// that q = -T and x = T of one step share it; reset by every hold and release).
+  mutable std::shared_ptr<const ArraySource> source_;
   /// generation_, watched by the sources (weakly: a source may outlive this record), which
   /// read the array only while it still says their generation.
   std::shared_ptr<std::uint64_t> liveGeneration_ = std::make_shared<std::uint64_t>(0);
