@@ -235,6 +235,22 @@ void AdmmSolver::setConstraintScales(std::span<const double> scales) {
   factored_ = false;
 }
 
+void AdmmSolver::setConstraintScales(const DeviceMatrix& scales) {
+  if (scales.onHost()) {
+    const Eigen::MatrixXd& values = scales.values();
+    setConstraintScales(std::span<const double>(values.data(), static_cast<std::size_t>(values.size())));
+    return;
+  }
+  if (scaleCount_ < 0) throwUsage("ADMM: constraint scales given before a constraint scaling");
+  if (scales.cols() != 1 || scales.rows() != scaleCount_) {
+    throwUsage("ADMM: " + std::to_string(scales.rows()) + " x " + std::to_string(scales.cols()) +
+               " constraint scales for a scaling of " + std::to_string(scaleCount_));
+  }
+  kernels_->setDeviceConstraintScales(scales);
+  scales_.clear();  // not known here: the next host scales are formed whatever they are
+  factored_ = false;
+}
+
 bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
                                  ActiveSetRefinementInfo& info) {
   const bool bySides = !request.sides.empty();
@@ -256,14 +272,15 @@ bool AdmmSolver::refineActiveSet(const ActiveSetRefinement& request, Eigen::Matr
 }
 
 double AdmmSolver::violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
-                               const SparseMatrix& C) {
+                               const std::function<const SparseMatrix&()>& hostC) {
   if (bounds.centre.rows() != m_ || bounds.relaxed.size() != static_cast<std::size_t>(m_) || x.rows() != n_ ||
-      q.rows() != n_ || x.cols() != bounds.centre.cols() || q.cols() != x.cols() || C.rows() != m_ ||
-      C.cols() != n_) {
-    throwUsage("ADMM: a violation needs q and x n x k, an m x k centre, m flags and an m x n C");
+      q.rows() != n_ || x.cols() != bounds.centre.cols() || q.cols() != x.cols()) {
+    throwUsage("ADMM: a violation needs q and x n x k, an m x k centre and m flags");
   }
   if (m_ == 0 || x.cols() == 0) return 0.0;
   if (const auto measured = kernels_->violationAt(q, bounds, x)) return *measured;
+  const SparseMatrix& C = hostC();
+  if (C.rows() != m_ || C.cols() != n_) throwUsage("ADMM: a violation needs an m x n C");
   return (C * x.values() - bounds.centre).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
 }
 

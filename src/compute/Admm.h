@@ -15,6 +15,7 @@
 //    compute shaders, so between two checks nothing but the block's submit crosses the bus.
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -208,6 +209,12 @@ class AdmmKernels {
   /// C's values from new scales (scaling.scaleCount of them, checked by the caller); as
   /// setConstraintValues, K changes at the next setRho.
   virtual void setConstraintScales(std::span<const double> scales) = 0;
+  /// setConstraintScales with the scales a device matrix (#scales x 1): kernels that keep C
+  /// where the matrix lives form C's values from it there. The default reads its values.
+  virtual void setDeviceConstraintScales(const DeviceMatrix& scales) {
+    const Eigen::MatrixXd& values = scales.values();
+    setConstraintScales({values.data(), static_cast<std::size_t>(values.size())});
+  }
   /// Load q (n x k), bounds (m x k) and warm starts x (n x k) and y (m x k), each of which
   /// may be empty for zero (set where the kernels keep the iterate: nothing copied to a
   /// device); z = clamp(C x, l, u), xTilde = x. q and x may be device matrices (DeviceMatrix):
@@ -314,9 +321,10 @@ class AdmmSolver {
   /// is not used), measured where the kernels keep the iterate: they are started at x (the
   /// next solve starts again), and a q, centre and flags that the next start shares are
   /// loaded for it already. For kernels that do not keep the iterate (no boundViolation),
-  /// the host's product with `C` (these kernels' C). NaN when C x is not finite.
+  /// the host's product with `hostC()` (these kernels' C, asked for only then: its values
+  /// may have to come from the device). NaN when C x is not finite.
   double violationAt(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
-                     const SparseMatrix& C);
+                     const std::function<const SparseMatrix&()>& hostC);
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) { kernels_->download(x, y, z); }
   /// AdmmKernels::solution and centreDistance on the last solve's iterate.
   std::optional<DeviceMatrix> solution() { return kernels_->solution(); }
@@ -343,6 +351,9 @@ class AdmmSolver {
   /// first setConstraintScales with them changes nothing either.
   void setConstraintScaling(ConstraintScaling scaling, std::span<const double> currentScales = {});
   void setConstraintScales(std::span<const double> scales);
+  /// The same with the scales a device matrix (#scales x 1): formed where the kernels keep C
+  /// when the matrix lives there (AdmmKernels::setDeviceConstraintScales), nothing compared.
+  void setConstraintScales(const DeviceMatrix& scales);
 
   /// AdmmKernels::refineActiveSet on the last solve's iterate; false when the kernels have
   /// none. The next solve forms K again.

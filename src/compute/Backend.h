@@ -66,6 +66,20 @@ struct DeviceIdealMaps {
   Index firstCentroidAtInfinity = -1;  ///< The lowest such face, or -1.
 };
 
+/// Projective fits a backend may keep where it computed them
+/// (Backend::fitProjectiveMapsOnDevice): what a global step and the positions after it read
+/// of them, and the tallies of their induced reciprocal scales.
+struct DeviceProjectiveFits {
+  /// 4 #F x 3: rows 4 f .. 4 f + 3 hold the first three columns of face f's map.
+  DeviceMatrix linearColumns;
+  /// #corners x 1, FaceList CSR order: (p, 1) . a4 for corner c of face f, p the corner's
+  /// source position and a4 the fourth column of f's map (the weight of the corner's image;
+  /// projective::ShapeSpace::inducedReciprocalScales).
+  DeviceMatrix reciprocalScales;
+  Index nonPositiveScales = 0;      ///< Corners whose scale is <= 0 (or not a number).
+  Index firstVanishingCorner = -1;  ///< The lowest corner with |scale| <= the limit asked for (or NaN); -1: none.
+};
+
 /// Which corners meet at each vertex (projective::ShapeSpace's tables).
 struct VertexCorners {
   std::span<const Index> offsets;     ///< #V + 1: vertex v's corners are corners[offsets[v] .. offsets[v + 1]).
@@ -73,8 +87,8 @@ struct VertexCorners {
   std::span<const Index> cornerFace;  ///< Per corner, its face.
 };
 
-/// Backend::affinePositions's result.
-struct AffinePositions {
+/// Backend::mapPositions's result.
+struct MapPositions {
   DeviceMatrix positions;      ///< #V x 3, the base positions' coordinates.
   double displacement = 0.0;   ///< max over vertices of |positions - previous|.
   double maxPlanarity = 0.0;   ///< Largest face planarity at `positions` (percent, mesh/Planarity.h).
@@ -89,9 +103,10 @@ void checkIdealMapInputs(const FaceList& faces, const Positions& source, std::sp
 /// `target` has as many rows as `source`.
 void checkFitInputs(const Positions& source, const Positions& target);
 
-/// Backend::affinePositions's input checks, one for every backend (Error(Usage)).
-void checkAffinePositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous);
+/// Backend::mapPositions's input checks, one for every backend (Error(Usage)).
+void checkMapPositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                            const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights,
+                            const DeviceMatrix& previous);
 
 /// Settings of an iterative or direct SPD solve.
 struct LinearSolverSettings {
@@ -189,20 +204,31 @@ class Backend {
   /// fitIdealMaps with the maps left where they were computed: the host reads only the
   /// methods' tallies, and the maps when a caller reads linearColumns' values. The default
   /// runs fitIdealMaps and keeps its maps on the host.
-  /// `target` may be a device matrix of this backend (affinePositions'): bound, not copied.
+  /// `target` may be a device matrix of this backend (mapPositions'): bound, not copied.
   virtual void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
                                     bool similar, DeviceIdealMaps& out);
 
-  /// Vertex positions of affine face maps given by their first three columns (4 #F x 3,
-  /// fourth columns (0, 0, 0, 1); projective::ShapeSpace::normalizedPositions for such maps):
-  /// each vertex the mean of its corner images (p, 1) A_f over the faces sharing it (p its
-  /// row of `base`), an isolated vertex its base position; with the largest distance of a
-  /// vertex from `previous` (#V x 3) and the largest planarity of `faces` there. A device
-  /// backend keeps the positions on the device (two scalars come back) and binds inputs
-  /// that are its own device matrices. Throws Error(Usage) for inputs of the wrong sizes,
+  /// fitProjectiveMaps with the maps left where they were computed, with each corner's
+  /// induced reciprocal scale on `source` and their tallies (DeviceProjectiveFits): the
+  /// host reads two numbers, and the maps or scales only when a caller reads their values.
+  /// `target` may be a device matrix of this backend (mapPositions'): bound, not copied.
+  /// The default runs fitProjectiveMaps and keeps everything on the host.
+  virtual void fitProjectiveMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
+                                         double vanishingScale, DeviceProjectiveFits& out);
+
+  /// Vertex positions of face maps given by their first three columns (4 #F x 3) and the
+  /// weights of their corner images (#corners x 1, the fourth columns' contribution
+  /// (p, 1) . a4: DeviceProjectiveFits::reciprocalScales; empty for affine maps, whose
+  /// weights are 1); projective::ShapeSpace::normalizedPositions: each vertex the mean of
+  /// its dehomogenized corner images (p, 1) A_f over the faces sharing it (p its row of
+  /// `base`), an isolated vertex its base position; with the largest distance of a vertex
+  /// from `previous` (#V x 3) and the largest planarity of `faces` there. A device backend
+  /// keeps the positions on the device (two scalars come back) and binds inputs that are
+  /// its own device matrices. Throws Error(Usage) for inputs of the wrong sizes,
   /// Error(Numerical) when a position is not finite.
-  virtual void affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out);
+  virtual void mapPositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                            const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights,
+                            const DeviceMatrix& previous, MapPositions& out);
 
   /// A solver for the SPD system matrix A (prefactored or uploaded once).
   virtual std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) = 0;

@@ -1,4 +1,7 @@
 #include "compute/Backend.h"
+
+#include <cmath>
+
 #include "compute/cpu/CpuBackend.h"
 #include "compute/vulkan/VulkanBackend.h"
 #include "core/Error.h"
@@ -63,29 +66,62 @@ void Backend::fitIdealMapsOnDevice(const FaceList& faces, const Positions& sourc
   out.linearColumns = DeviceMatrix(std::move(columns));
 }
 
-void checkAffinePositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                               const DeviceMatrix& mapColumns, const DeviceMatrix& previous) {
+void Backend::fitProjectiveMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
+                                        double vanishingScale, DeviceProjectiveFits& out) {
+  ProjectiveFits fits;
+  fitProjectiveMaps(faces, source, Positions(target.values()), fits);
+  const Index faceCount = faces.size();
+  Eigen::MatrixXd columns(4 * static_cast<Eigen::Index>(faceCount), 3);
+  Eigen::MatrixXd scales(faces.cornerCount(), 1);
+  out.nonPositiveScales = 0;
+  out.firstVanishingCorner = -1;
+  for (Index f = 0; f < faceCount; ++f) {
+    const Eigen::Matrix4d& map = fits.maps[static_cast<std::size_t>(f)];
+    columns.middleRows<4>(4 * static_cast<Eigen::Index>(f)) = map.leftCols<3>();
+    // The fit's own scales are taken on the plane-projected corners; these on `source`.
+    for (Index c = faces.offsets()[f]; c < faces.offsets()[f + 1]; ++c) {
+      const Index v = faces.indices()[c];
+      const double s = Eigen::RowVector4d(source(v, 0), source(v, 1), source(v, 2), 1.0).dot(map.col(3));
+      scales(c, 0) = s;
+      if (!(s > 0.0)) ++out.nonPositiveScales;
+      if (!(std::abs(s) > vanishingScale) && out.firstVanishingCorner < 0) out.firstVanishingCorner = c;
+    }
+  }
+  out.linearColumns = DeviceMatrix(std::move(columns));
+  out.reciprocalScales = DeviceMatrix(std::move(scales));
+}
+
+void checkMapPositionInputs(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                            const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights,
+                            const DeviceMatrix& previous) {
   const auto vertexCount = static_cast<std::size_t>(base.rows());
   if (corners.offsets.size() != vertexCount + 1 || corners.corners.size() != corners.cornerFace.size() ||
       static_cast<std::size_t>(corners.offsets.back()) != corners.corners.size() ||
       corners.cornerFace.size() != static_cast<std::size_t>(faces.cornerCount())) {
-    throwUsage("affinePositions: vertex corner tables of the wrong sizes for " + std::to_string(vertexCount) +
+    throwUsage("mapPositions: vertex corner tables of the wrong sizes for " + std::to_string(vertexCount) +
                " vertices and " + std::to_string(faces.cornerCount()) + " corners");
   }
   if (mapColumns.rows() != 4 * static_cast<Eigen::Index>(faces.size()) || mapColumns.cols() != 3) {
-    throwUsage("affinePositions: map columns of " + std::to_string(mapColumns.rows()) + " x " +
+    throwUsage("mapPositions: map columns of " + std::to_string(mapColumns.rows()) + " x " +
                std::to_string(mapColumns.cols()) + " for " + std::to_string(faces.size()) + " faces");
   }
+  if (cornerWeights.size() != 0 && (cornerWeights.rows() != faces.cornerCount() || cornerWeights.cols() != 1)) {
+    throwUsage("mapPositions: corner weights of " + std::to_string(cornerWeights.rows()) + " x " +
+               std::to_string(cornerWeights.cols()) + " for " + std::to_string(faces.cornerCount()) + " corners");
+  }
   if (previous.rows() != base.rows() || previous.cols() != 3) {
-    throwUsage("affinePositions: previous positions of " + std::to_string(previous.rows()) + " rows for " +
+    throwUsage("mapPositions: previous positions of " + std::to_string(previous.rows()) + " rows for " +
                std::to_string(vertexCount) + " vertices");
   }
 }
 
-void Backend::affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                              const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out) {
-  checkAffinePositionInputs(faces, base, corners, mapColumns, previous);
+void Backend::mapPositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                           const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights,
+                           const DeviceMatrix& previous, MapPositions& out) {
+  checkMapPositionInputs(faces, base, corners, mapColumns, cornerWeights, previous);
   const Eigen::MatrixXd& X = mapColumns.values();
+  const bool weighted = cornerWeights.size() != 0;
+  const Eigen::MatrixXd& weights = weighted ? cornerWeights.values() : X;  // read only when weighted
   Positions positions = base;
   for (Eigen::Index v = 0; v < base.rows(); ++v) {
     const Index begin = corners.offsets[v];
@@ -94,12 +130,17 @@ void Backend::affinePositions(const FaceList& faces, const Positions& base, cons
     const Eigen::RowVector4d p(base(v, 0), base(v, 1), base(v, 2), 1.0);
     Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
     for (Index k = begin; k < end; ++k) {
-      const Eigen::Matrix<double, 4, 3> M = X.middleRows<4>(4 * static_cast<Eigen::Index>(corners.cornerFace[corners.corners[k]]));
-      sum += p * M;
+      const Index corner = corners.corners[k];
+      const Eigen::Matrix<double, 4, 3> M = X.middleRows<4>(4 * static_cast<Eigen::Index>(corners.cornerFace[corner]));
+      if (weighted) {
+        sum += (p * M) / weights(corner, 0);
+      } else {
+        sum += p * M;
+      }
     }
     positions.row(v) = sum / static_cast<double>(end - begin);
   }
-  if (!positions.allFinite()) throwNumerical("affinePositions: a vertex position from the maps is not finite");
+  if (!positions.allFinite()) throwNumerical("mapPositions: a vertex position from the maps is not finite");
   out.displacement = maxVertexDistance(Positions(previous.values()), positions);
   out.maxPlanarity = planarityStats(PolygonMesh{positions, faces}).max;
   out.positions = DeviceMatrix(Eigen::MatrixXd(positions));

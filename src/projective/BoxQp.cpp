@@ -75,6 +75,8 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
 void BoxQpSolver::setConstraintScaling(const compute::ConstraintScaling& scaling,
                                        std::span<const double> currentScales) {
   admm_->setConstraintScaling(scaling, currentScales);
+  scaling_ = scaling;
+  pendingScales_.reset();
 }
 
 void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales) {
@@ -83,12 +85,33 @@ void BoxQpSolver::setScaledConstraintValues(const compute::SparseMatrix& C, std:
     throwUsage("box QP: new constraint values on a different sparsity pattern");
   }
   admm_->setConstraintScales(scales);
+  pendingScales_.reset();  // C is given whole
   // The same values (a rigid deformation's steps: every scale 1) leave the all-rows
   // factorization valid. (A C without entries may have no value array to compare.)
   const auto bytes = static_cast<std::size_t>(C.nonZeros()) * sizeof(double);
   if (bytes == 0 || std::memcmp(C.valuePtr(), C_.valuePtr(), bytes) == 0) return;
   std::copy_n(C.valuePtr(), C.nonZeros(), C_.valuePtr());
   allRowsCurrent_ = false;
+}
+
+void BoxQpSolver::setConstraintScales(const compute::DeviceMatrix& scales) {
+  if (static_cast<std::size_t>(scaling_.coefficients.size()) != static_cast<std::size_t>(C_.nonZeros())) {
+    throwUsage("box QP: constraint scales given before a constraint scaling");
+  }
+  admm_->setConstraintScales(scales);
+  // C's host values follow only if a host step reads them (hostC): on a device they are
+  // formed there, and the scales stay.
+  pendingScales_ = scales;
+  allRowsCurrent_ = false;
+}
+
+const compute::SparseMatrix& BoxQpSolver::hostC() {
+  if (pendingScales_) {
+    const Eigen::MatrixXd& scales = pendingScales_->values();
+    compute::fillScaledValues(scaling_, {scales.data(), static_cast<std::size_t>(scales.size())}, C_.valuePtr());
+    pendingScales_.reset();
+  }
+  return C_;
 }
 
 BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower,
@@ -126,7 +149,7 @@ double BoxQpSolver::centreDistance(const compute::DeviceMatrix& x, const compute
   }
   const Eigen::Index m = C_.rows();
   if (m == 0 || x.cols() == 0) return 0.0;
-  const Eigen::MatrixXd distance = (C_ * x.values() - bounds.centre).cwiseAbs();
+  const Eigen::MatrixXd distance = (hostC() * x.values() - bounds.centre).cwiseAbs();
   double largest = 0.0;
   for (Eigen::Index r = 0; r < m; ++r) {
     if (!relaxedRows && bounds.relaxed[static_cast<std::size_t>(r)]) continue;
@@ -139,7 +162,7 @@ double BoxQpSolver::centreDistance(const compute::DeviceMatrix& x, const compute
 
 double BoxQpSolver::violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                                 const compute::DeviceMatrix& x) {
-  return admm_->violationAt(q, bounds, x, C_);
+  return admm_->violationAt(q, bounds, x, [this]() -> const compute::SparseMatrix& { return hostC(); });
 }
 
 BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower,
@@ -198,7 +221,7 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
     fetchSolution();
   }
   // On the device the kernels measure it at the iterate they keep: the solution.
-  info.maxBoundViolation = onDevice ? admm_->boundViolation() : boundViolation(C_ * x, lower, upper);
+  info.maxBoundViolation = onDevice ? admm_->boundViolation() : boundViolation(hostC() * x, lower, upper);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
   if (kept && !onDevice) *kept = compute::DeviceMatrix(std::move(x));
   return info;
@@ -266,7 +289,7 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
                          const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements) {
   const Eigen::Index m = C_.rows();
   const Eigen::Index k = q.cols();
-  const double before = boundViolation(C_ * x, lower, upper);
+  const double before = boundViolation(hostC() * x, lower, upper);
 
   // Active set per column, as in OSQP: equality rows, and rows whose dual pushes z onto a
   // bound; the bound is the row's target.
@@ -332,7 +355,7 @@ bool BoxQpSolver::polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower,
     if (!solved.factored) return false;
   }
   if (!xPolished.allFinite()) return false;
-  const double after = boundViolation(C_ * xPolished, lower, upper);
+  const double after = boundViolation(hostC() * xPolished, lower, upper);
   if (!(after <= std::max(before, 1e-12))) return false;
   x = xPolished;
   y = yPolished;
@@ -353,9 +376,9 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
     return settings_.absoluteTolerance + settings_.relativeTolerance * std::max(norm(Cx, c), norm(d, c));
   };
   const auto converged = [&](const Eigen::MatrixXd& xv, const Eigen::MatrixXd& yv, bool checkDual) {
-    const Eigen::MatrixXd Cx = C_ * xv;
+    const Eigen::MatrixXd Cx = hostC() * xv;
     const Eigen::MatrixXd Px = P_ * xv;
-    const Eigen::MatrixXd Cty = C_.transpose() * yv;
+    const Eigen::MatrixXd Cty = hostC().transpose() * yv;
     const Eigen::MatrixXd primal = Cx - d;
     const Eigen::MatrixXd dual = Px + q + Cty;
     info.primalResidual = infNorm(primal);
@@ -396,9 +419,9 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
   // least-squares residual r = Cx - d, orthogonal to C's range, and the multipliers grow
   // along it: OSQP's certificate with dy = r (C^T dy ~ 0 and, l = u = d, d^T dy =
   // -||r||^2 < 0). The warm starts stay as given for the relaxed attempts.
-  const Eigen::MatrixXd Cx = C_ * xs;
+  const Eigen::MatrixXd Cx = hostC() * xs;
   const Eigen::MatrixXd r = Cx - d;
-  const Eigen::MatrixXd Ctr = C_.transpose() * r;
+  const Eigen::MatrixXd Ctr = hostC().transpose() * r;
   const double tolerance = settings_.infeasibilityTolerance;
   for (Eigen::Index c = 0; c < k; ++c) {
     const double size = norm(r, c);
@@ -427,7 +450,7 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
   }
   compute::SparseMatrix selector(static_cast<Eigen::Index>(entries.size()), m);
   selector.setFromTriplets(entries.begin(), entries.end());
-  const compute::SparseMatrix CA = selector * C_;
+  const compute::SparseMatrix CA = selector * hostC();
   const compute::SparseMatrix CAt = CA.transpose();
   const double rhoP = settings_.polishRho;
   const bool allRows = CA.rows() == m;
@@ -506,6 +529,17 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
     y.col(columns[j]) = selector.transpose() * lambda.col(j);
   }
   return result;
+}
+
+BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
+                        const ScaledConstraintMatrix& C, const compute::DeviceMatrix& scales,
+                        const BoxQpSettings& settings) {
+  if (!kept) {
+    kept = std::make_unique<BoxQpSolver>(backend, P, C.matrix(), settings);  // C's pattern; its values follow
+    kept->setConstraintScaling(C.scaling());
+  }
+  kept->setConstraintScales(scales);
+  return *kept;
 }
 
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,

@@ -24,6 +24,7 @@
 // step's dearest part, and ended in that same polish.
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -169,6 +170,10 @@ class BoxQpSolver {
   /// as compute::AdmmSolver::setConstraintScaling's.
   void setConstraintScaling(const compute::ConstraintScaling& scaling, std::span<const double> currentScales = {});
   void setScaledConstraintValues(const compute::SparseMatrix& C, std::span<const double> scales);
+  /// New values by their scales (#scales x 1) alone, which may stay on the device that
+  /// computed them (compute::AdmmSolver::setConstraintScales); C's values here are formed
+  /// from them only when a step on the host needs them (their copy then comes over).
+  void setConstraintScales(const compute::DeviceMatrix& scales);
   /// The rho the next solve starts at (compute::AdmmSolver::rho, setRho).
   double rho() const { return admm_->rho(); }
   void setRho(double rho) { admm_->setRho(rho); }
@@ -213,10 +218,15 @@ class BoxQpSolver {
                                 const Eigen::MatrixXd& q, const Eigen::MatrixXd& targets, Refinement form,
                                 Eigen::MatrixXd& x, Eigen::MatrixXd& y);
 
+  /// C with its values for the last scales given (formed from pendingScales_ first).
+  const compute::SparseMatrix& hostC();
+
   compute::Backend& backend_;
   BoxQpSettings settings_;
   compute::SparseMatrix P_;
-  compute::SparseMatrix C_;
+  compute::SparseMatrix C_;  ///< Its values are stale while pendingScales_ holds scales.
+  compute::ConstraintScaling scaling_;
+  std::optional<compute::DeviceMatrix> pendingScales_;
   std::unique_ptr<compute::AdmmSolver> admm_;
   /// The solver of the system with every row active (each direct equality solve's, an
   /// all-equality polish's) where the backend factors: its pattern is C's, fixed for this
@@ -236,5 +246,10 @@ class BoxQpSolver {
 /// over from one problem to the next (they are alike). `settings` is used on creation only.
 BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
                         const ScaledConstraintMatrix& C, std::span<const double> scales, const BoxQpSettings& settings);
+/// keptSolver with C's new scales alone, which may stay on the device that computed them
+/// (BoxQpSolver::setConstraintScales; C need not be filled for them).
+BoxQpSolver& keptSolver(std::unique_ptr<BoxQpSolver>& kept, compute::Backend& backend, const compute::SparseMatrix& P,
+                        const ScaledConstraintMatrix& C, const compute::DeviceMatrix& scales,
+                        const BoxQpSettings& settings);
 
 }  // namespace plano::projective

@@ -43,7 +43,6 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
   for (Index i = 0; i < fixedCount_; ++i) targets.row(i) = space_.baseMesh().vertices.row(constrained_[i]);
   if (handleCount > 0) targets.bottomRows(handleCount) = handles;
 
-  const double diagonal = space_.normalization().scale;
   const double planarityBound = std::max(settings_.planarityTolerance, planarityStats(space_.baseMesh()).max);
   DeformationInfo info;
   std::optional<compute::DeviceTransfers> transfersBefore;
@@ -67,15 +66,23 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     return it;
   };
 
-  // Phase 1's positions, normalized, where the backend computes them: on a device the loop
-  // below moves no mesh-sized data between host and device (the ideal maps, the global
-  // step's solution and these positions stay there; scalars come back).
+  // The positions, normalized, where the backend computes them: on a device both loops
+  // below move no mesh-sized data between host and device (the fits, the global step's
+  // solution and these positions stay there; scalars come back).
   compute::DeviceMatrix current(Eigen::MatrixXd(normalizedTargetPositions(space_, positions)));
   bool currentIsNewer = false;  // `current` holds positions that `positions` does not yet
   const compute::VertexCorners corners = space_.vertexCorners();
+  auto advance = [&](DeformationPhase phase, const GlobalStepInfo& step, const compute::DeviceMatrix& columns,
+                     const compute::DeviceMatrix& cornerWeights) {
+    compute::MapPositions next;
+    backend_.mapPositions(space_.faces(), space_.basePositions(), corners, columns, cornerWeights, current, next);
+    const DeformationIteration it = record(phase, step, next.displacement, next.maxPlanarity);
+    current = std::move(next.positions);
+    currentIsNewer = true;
+    return it;
+  };
   try {
     bool converged = false;
-    FaceMaps maps;
     // Phase 1 (§6.1): fit, closest rigid/similar map, global step.
     for (int k = 0; k < settings_.maxIterations && !converged; ++k) {
       throwIfCancelled("deformation");
@@ -83,29 +90,23 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
       const compute::DeviceMatrix ideal = idealMapsOfNormalized(backend_, space_, current, settings_.energy);
       compute::DeviceMatrix columns;
       const GlobalStepInfo step = global_.solveAffine(ideal, targets, columns);
-      compute::AffinePositions next;
-      backend_.affinePositions(space_.faces(), space_.basePositions(), corners, columns, current, next);
-      const DeformationIteration it = record(DeformationPhase::Ideal, step, next.displacement, next.maxPlanarity);
-      current = std::move(next.positions);
-      currentIsNewer = true;
-      converged = it.displacement < settings_.tolerance;
+      converged = advance(DeformationPhase::Ideal, step, columns, {}).displacement < settings_.tolerance;
     }
-    if (currentIsNewer) positions = space_.normalization().toWorld(Positions(current.values()));
-    currentIsNewer = false;
     // Phase 2 (§5 loop): projective fits of the current faces, projected with the same
     // constraints, until the faces are planar again.
     bool planar = !info.history.empty() && info.history.back().maxPlanarity <= planarityBound;
     for (int k = 0; k < settings_.maxProjectionIterations && !planar; ++k) {
       throwIfCancelled("deformation (projection)");
       transfersBefore = backend_.transfers();
-      const LocalStepResult fit = fitFaceMaps(backend_, space_, positions);
-      const GlobalStepInfo step = global_.solve(fit.fits.maps, targets, maps);
-      const Positions next = space_.positions(maps.maps);
-      const double displacement = maxVertexDistance(next, positions) / diagonal;
-      planar = record(DeformationPhase::Projection, step, displacement, planarityStats(PolygonMesh{next, space_.faces()}).max)
-                   .maxPlanarity <= planarityBound;
-      positions = next;
+      compute::DeviceProjectiveFits fits;
+      backend_.fitProjectiveMapsOnDevice(space_.faces(), space_.basePositions(), current,
+                                         GlobalStep::kMinimumReciprocalScale, fits);
+      compute::DeviceMatrix columns;
+      const GlobalStepInfo step = global_.solve(fits, targets, columns);
+      planar = advance(DeformationPhase::Projection, step, columns, fits.reciprocalScales).maxPlanarity <=
+               planarityBound;
     }
+    if (currentIsNewer) positions = space_.normalization().toWorld(Positions(current.values()));
     info.status = converged && planar ? DeformationStatus::Converged : DeformationStatus::MaxIterationsReached;
   } catch (const Error& e) {
     if (e.kind() != ErrorKind::Numerical) throw;

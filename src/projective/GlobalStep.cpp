@@ -11,13 +11,14 @@
 namespace plano::projective {
 namespace {
 
-/// Below this |shat| a corner is mapped (numerically) to the plane at infinity.
-constexpr double kMinimumReciprocalScale = 1e-10;
-
 std::string formatDouble(double value) {
   std::ostringstream s;
   s << value;
   return s.str();
+}
+
+compute::DeviceMatrix scaleColumn(const std::vector<double>& scales) {
+  return Eigen::Map<const Eigen::VectorXd>(scales.data(), static_cast<Eigen::Index>(scales.size()));
 }
 
 /// maps = one per four rows of x (4 #F x 3), their first three columns those rows.
@@ -109,7 +110,7 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   for (Index f = 0; f < faceCount; ++f) {
     if (!targets[f].allFinite()) throwNumerical("global step: the target map of face " + std::to_string(f) + " is not finite");
   }
-  std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  const std::vector<double> shat = space_.inducedReciprocalScales(targets);
   Index nonPositive = 0;
   for (Index c = 0; c < space_.cornerCount(); ++c) {
     if (shat[c] <= 0.0) ++nonPositive;
@@ -122,11 +123,31 @@ GlobalStepInfo GlobalStep::solve(const std::vector<Eigen::Matrix4d>& targets, co
   Eigen::MatrixXd T(4 * faceCount, 3);
   for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
   compute::DeviceMatrix columns;
-  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), shat, positions, columns);
+  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), scaleColumn(shat), positions, columns);
   info.nonPositiveScales = nonPositive;
   setFirstColumns(columns.values(), result.maps);
   for (Index f = 0; f < faceCount; ++f) result.maps[f].col(3) = targets[f].col(3);
-  result.reciprocalScales = std::move(shat);
+  result.reciprocalScales = shat;
+  return info;
+}
+
+GlobalStepInfo GlobalStep::solve(const compute::DeviceProjectiveFits& fits, const Positions& positions,
+                                 compute::DeviceMatrix& resultColumns) {
+  const Index faceCount = space_.faceCount();
+  if (fits.linearColumns.rows() != 4 * static_cast<Eigen::Index>(faceCount) || fits.linearColumns.cols() != 3 ||
+      fits.reciprocalScales.rows() != space_.cornerCount() || fits.reciprocalScales.cols() != 1) {
+    throwUsage("global step: projective fits of " + std::to_string(fits.linearColumns.rows()) + " x " +
+               std::to_string(fits.linearColumns.cols()) + " columns and " +
+               std::to_string(fits.reciprocalScales.rows()) + " scales for " + std::to_string(faceCount) +
+               " faces and " + std::to_string(space_.cornerCount()) + " corners");
+  }
+  if (const Index c = fits.firstVanishingCorner; c >= 0) {  // the scales come over to say which
+    throwNumerical("global step: the target map of face " + std::to_string(space_.cornerFace(c)) + " sends vertex " +
+                   std::to_string(space_.faces().indices()[c]) + " to infinity (reciprocal scale factor " +
+                   formatDouble(fits.reciprocalScales.values()(c, 0)) + ")");
+  }
+  GlobalStepInfo info = project(fits.linearColumns, fits.reciprocalScales, positions, resultColumns);
+  info.nonPositiveScales = fits.nonPositiveScales;
   return info;
 }
 
@@ -148,10 +169,10 @@ GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumn
                std::to_string(linearColumns.cols()) + " for " + std::to_string(faceCount) + " faces (need 4 #F x 3)");
   }
   // Fourth columns (0, 0, 0, 1): every corner's reciprocal scale factor is 1.
-  return project(linearColumns, std::vector<double>(space_.cornerCount(), 1.0), positions, resultColumns);
+  return project(linearColumns, Eigen::MatrixXd::Ones(space_.cornerCount(), 1), positions, resultColumns);
 }
 
-GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const std::vector<double>& shat,
+GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute::DeviceMatrix& shat,
                                    const Positions& positions, compute::DeviceMatrix& x) {
   const Index faceCount = space_.faceCount();
   if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
@@ -175,14 +196,22 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const std::ve
     }
     d.row(r) = q;
   }
-  constraints_.fill(shat);  // the kept solver takes C from it
-
   // C's pattern depends on the topology (and the constrained vertices) only: one solver
-  // for the object's lifetime.
+  // for the object's lifetime. Scales on the host fill C here (the kept solver takes it);
+  // scales on a device form C's values there.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
   qpSettings.returnDuals = false;      // every attempt starts from zero duals
-  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
+  BoxQpSolver* solver = nullptr;
+  if (shat.onHost()) {
+    const Eigen::MatrixXd& scales = shat.values();
+    const std::span<const double> values(scales.data(), static_cast<std::size_t>(scales.size()));
+    constraints_.fill(values);
+    solver = &keptSolver(qp_, backend_, P_, constraints_, values, qpSettings);
+  } else {
+    solver = &keptSolver(qp_, backend_, P_, constraints_, shat, qpSettings);
+  }
+  BoxQpSolver& qp = *solver;
   compute::RelaxedBounds bounds{std::move(d), std::vector<char>(m), 0.0};
   for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
 

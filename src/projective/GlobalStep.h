@@ -122,6 +122,17 @@ class GlobalStep {
   /// this object lives and until its next solve: Error(Usage) after).
   GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
                              compute::DeviceMatrix& resultColumns);
+  /// solve() for projective fits kept where the backend computed them (compute::Backend::
+  /// fitProjectiveMapsOnDevice, their scales' vanishing limit kMinimumReciprocalScale): the
+  /// targets their first three columns, C_s's values formed from their induced scales, both
+  /// where they are; the result's first three columns as solveAffine's (the fourth columns
+  /// are the fits', unchanged; its corner weights the fits' scales). Throws as solve().
+  GlobalStepInfo solve(const compute::DeviceProjectiveFits& fits, const Positions& positions,
+                       compute::DeviceMatrix& resultColumns);
+
+  /// Below this |shat| a corner is mapped (numerically) to the plane at infinity: no map
+  /// sends a vertex there.
+  static constexpr double kMinimumReciprocalScale = 1e-10;
 
   const std::vector<Index>& constrainedVertices() const { return constrained_; }
   const GlobalStepSettings& settings() const { return settings_; }
@@ -136,9 +147,10 @@ class GlobalStep {
   };
 
   /// The solves after their target checks: T (4 #F x 3) the targets' first three columns,
-  /// shat their reciprocal scales; x receives the maps' first three columns (4 #F x 3).
-  GlobalStepInfo project(const compute::DeviceMatrix& T, const std::vector<double>& shat, const Positions& positions,
-                         compute::DeviceMatrix& x);
+  /// shat (#corners x 1) their reciprocal scales; x receives the maps' first three columns
+  /// (4 #F x 3).
+  GlobalStepInfo project(const compute::DeviceMatrix& T, const compute::DeviceMatrix& shat,
+                         const Positions& positions, compute::DeviceMatrix& x);
 
   compute::Backend& backend_;
   const ShapeSpace& space_;

@@ -60,7 +60,7 @@ std::vector<Eigen::Matrix4d> fittedIdealMaps(compute::Backend& backend, const Sh
 compute::DeviceMatrix fittedIdealMapsOnDevice(compute::Backend& backend, const ShapeSpace& space,
                                               const Positions& target, IdealMapKind kind, Index* fallbacks = nullptr);
 /// The same for target positions already in normalized coordinates (#V x 3), which may be a
-/// device matrix of the backend's (Backend::affinePositions): bound where they are.
+/// device matrix of the backend's (Backend::mapPositions): bound where they are.
 compute::DeviceMatrix idealMapsOfNormalized(compute::Backend& backend, const ShapeSpace& space,
                                             const compute::DeviceMatrix& normalizedTarget, IdealMapKind kind,
                                             Index* fallbacks = nullptr);

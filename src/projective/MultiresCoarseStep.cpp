@@ -8,9 +8,6 @@
 namespace plano::projective {
 namespace {
 
-/// Below this |shat| a point is mapped (numerically) to the plane at infinity.
-constexpr double kMinimumReciprocalScale = 1e-10;
-
 std::string number(double value) {
   std::ostringstream s;
   s << value;
@@ -116,7 +113,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
   const std::vector<double> shat = space_.inducedReciprocalScales(targets);
   for (Index c = 0; c < space_.cornerCount(); ++c) {
     if (shat[c] <= 0.0) ++info.nonPositiveScales;
-    if (!(std::abs(shat[c]) > kMinimumReciprocalScale)) {
+    if (!(std::abs(shat[c]) > GlobalStep::kMinimumReciprocalScale)) {
       throwNumerical("coarse global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
                      " sends vertex " + std::to_string(space_.faces().indices()[c]) + " to infinity");
     }
@@ -134,7 +131,7 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
       const MapPointConstraint& h = handles_[row.handle];
       const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
       const double scale = p.dot(targets[h.face].col(3).transpose());
-      if (!(std::abs(scale) > kMinimumReciprocalScale)) {
+      if (!(std::abs(scale) > GlobalStep::kMinimumReciprocalScale)) {
         throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
                        std::to_string(h.handle) + " to infinity");
       }

@@ -46,7 +46,7 @@ class ShapeSpace {
   /// Corners of vertex v: cornersOfVertex[vertexCornerOffsets[v] .. vertexCornerOffsets[v+1]).
   const std::vector<Index>& vertexCornerOffsets() const { return vertexCornerOffsets_; }
   const std::vector<Index>& cornersOfVertex() const { return cornersOfVertex_; }
-  /// These tables and each corner's face, as a backend takes them (Backend::affinePositions).
+  /// These tables and each corner's face, as a backend takes them (Backend::mapPositions).
   compute::VertexCorners vertexCorners() const { return {vertexCornerOffsets_, cornersOfVertex_, cornerFace_}; }
   Index vertexDegree(Index v) const { return vertexCornerOffsets_[v + 1] - vertexCornerOffsets_[v]; }
   /// Pairs (f, g), f < g, of faces sharing an edge (the smoothness term of §6.3).

@@ -248,17 +248,62 @@ TEST_F(GlobalStepTest, CornerAtInfinityIsANumericalError) {
   }
 }
 
+TEST_F(GlobalStepTest, ProjectiveFitsByTheirColumnsAndScalesGiveTheSameStepAsTheMaps) {
+  // Projective fits of a perturbed similarity (their scales are not 1), with fixed vertices.
+  const PolygonMesh mesh = generate::translationalSurface(6, 5);
+  const ShapeSpace space(mesh);
+  const std::vector<Index> fixed = {0, 1, 2, 3, 4, 5, 6};  // the first row, where it is
+  const Positions at = mesh.vertices.topRows(7);
+  const Positions target = test::rotatedScaledAndPerturbed(mesh.vertices, 1.1, 0.03, 5);
+  const LocalStepResult local = fitFaceMaps(backend, space, target);
+  compute::DeviceProjectiveFits fits;
+  backend.fitProjectiveMapsOnDevice(mesh.faces, space.basePositions(), normalizedTargetPositions(space, target),
+                                    GlobalStep::kMinimumReciprocalScale, fits);
+
+  FaceMaps byMaps;
+  compute::DeviceMatrix byFits;
+  const GlobalStepInfo a = GlobalStep(backend, space, fixed).solve(local.fits.maps, at, byMaps);
+  const GlobalStepInfo b = GlobalStep(backend, space, fixed).solve(fits, at, byFits);
+  EXPECT_GT(a.admmIterations + a.polishRefinements, 0);  // not a trivial step
+  EXPECT_EQ(a.initialViolation, b.initialViolation);
+  EXPECT_EQ(a.epsilon, b.epsilon);
+  EXPECT_EQ(a.admmIterations, b.admmIterations);
+  EXPECT_EQ(a.nonPositiveScales, b.nonPositiveScales);
+  ASSERT_EQ(byFits.rows(), 4 * space.faceCount());
+  for (Index f = 0; f < space.faceCount(); ++f) {
+    EXPECT_EQ(Eigen::MatrixXd(byMaps.maps[f].leftCols<3>()), Eigen::MatrixXd(byFits.values().middleRows<4>(4 * f)))
+        << "face " << f;
+  }
+
+  // A corner sent to infinity names its face and vertex; fits of the wrong size are a usage error.
+  const Index corner = space.faces().offsets()[4] + 1;
+  fits.firstVanishingCorner = corner;
+  try {
+    GlobalStep(backend, space, fixed).solve(fits, at, byFits);
+    ADD_FAILURE() << "expected Error(Numerical)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    EXPECT_NE(std::string(e.what()).find("face 4 sends vertex " + std::to_string(space.faces().indices()[corner])),
+              std::string::npos)
+        << e.what();
+  }
+  fits.firstVanishingCorner = -1;
+  fits.reciprocalScales = Eigen::MatrixXd::Ones(3, 1);
+  try {
+    GlobalStep(backend, space, fixed).solve(fits, at, byFits);
+    ADD_FAILURE() << "expected Error(Usage)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+  }
+}
+
 TEST_F(GlobalStepTest, AffineTargetsByTheirColumnsGiveTheSameStepAsTheMaps) {
   // Ideal maps of a perturbed rigid motion (affine), with fixed vertices: an ε schedule
   // with ADMM attempts, then the direct solve.
   const PolygonMesh mesh = generate::translationalSurface(6, 5);
   const ShapeSpace space(mesh);
-  std::vector<Index> fixed;
-  Positions at(7, 3);
-  for (Index v = 0; v < 7; ++v) {
-    fixed.push_back(v);
-    at.row(v) = mesh.vertices.row(v);
-  }
+  const std::vector<Index> fixed = {0, 1, 2, 3, 4, 5, 6};  // the first row, where it is
+  const Positions at = mesh.vertices.topRows(7);
   const Positions target = test::rotatedScaledAndPerturbed(mesh.vertices, 1.0, 0.03, 4);
   const auto ideal = fittedIdealMaps(backend, space, target, IdealMapKind::Rigid);
   Eigen::MatrixXd columns(4 * space.faceCount(), 3);

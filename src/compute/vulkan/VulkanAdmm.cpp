@@ -529,6 +529,25 @@ void AdmmKernels::setConstraintScales(std::span<const double> scales) {
   scaledUpdate_.run();
 }
 
+void AdmmKernels::setDeviceConstraintScales(const compute::DeviceMatrix& scales) {
+  const Array<double>* array = scales.cols() == 1 ? arrayOf(scales, context_, ArrayLayout::ColumnMajor) : nullptr;
+  if (!array) {  // host values, or another context's
+    const Eigen::MatrixXd& values = scales.values();
+    setConstraintScales({values.data(), static_cast<std::size_t>(values.size())});
+    return;
+  }
+  if (!scales_) throwUsage("ADMM: constraint scales given before a constraint scaling");
+  k1Current_ = false;
+  if (C_.nonZeros() == 0 || scales.size() == 0) return;
+  // Copied where they are (the fit kernel's induced scales), then formed as uploaded ones.
+  Sequence copy(context_);
+  copy.begin();
+  copy.copy(*array, *scales_, static_cast<std::size_t>(scales.size()) * sizeof(double));
+  copy.end();
+  copy.run();
+  scaledUpdate_.run();
+}
+
 namespace {
 
 std::uint64_t longestRow(const compute::SparseMatrix& A) {
@@ -838,10 +857,12 @@ bool AdmmKernels::loadLinearTerm(const compute::DeviceMatrix& q) {
   // A global step's q = -T of the ideal maps the backend's kernel just computed, left on the
   // device (a DeviceMatrix of theirs) or downloaded (host values equal to them): formed from
   // them where they are, bit for bit the host's.
-  const Array<double>* maps = residentMaps_ ? residentMaps_->holdingColumns(q, -1.0) : nullptr;
+  // (Face maps of this context in a device matrix: the ideal maps, or the projective fits.)
+  const ArraySource* mapsSource = q.factor() == -1.0 ? arraySourceOf(q, context_, ArrayLayout::FaceMapColumns) : nullptr;
+  const Array<double>* maps = mapsSource ? mapsSource->arrayIn(context_) : nullptr;
   if (maps) {
     // The attempts of one global step's ε schedule solve with one q (only the bounds widen).
-    if (w.residentQGeneration == residentMaps_->generation()) return true;
+    if (w.residentQGeneration == mapsSource->generation()) return true;
   } else {
     const Eigen::MatrixXd& values = q.values();
     if (w.residentQGeneration == 0 && w.uploadedQ.rows() == values.rows() && w.uploadedQ.cols() == values.cols() &&
@@ -865,10 +886,10 @@ bool AdmmKernels::loadLinearTerm(const compute::DeviceMatrix& q) {
              NegatedMapsPush{faceCount, k}, groupsFor(context_, static_cast<std::size_t>(n_) * k));
   s.end();
   s.run();
-  if (q.onHost()) {
-    w.uploadedQ = q.values();
+  if (mapsSource) {
+    w.residentQGeneration = mapsSource->generation();
   } else {
-    w.residentQGeneration = residentMaps_->generation();
+    w.uploadedQ = q.values();
   }
   return true;
 }

@@ -120,6 +120,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// (shaders/admm_scaled_values.comp). The host copy of C keeps its pattern only.
   void setConstraintScaling(const compute::ConstraintScaling& scaling) override;
   void setConstraintScales(std::span<const double> scales) override;
+  /// Scales in a device array of this context are copied on the device, others uploaded.
+  void setDeviceConstraintScales(const compute::DeviceMatrix& scales) override;
   /// q, the centre and flags of relaxed bounds are uploaded only when they differ from the
   /// last start's, l and u of relaxed bounds are formed on the device
   /// (shaders/admm_relaxed_bounds.comp), and so are warm starts that are empty (zero) or,

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "compute/vulkan/VulkanAdmm.h"
-#include "compute/vulkan/VulkanAffinePositions.h"
+#include "compute/vulkan/VulkanMapPositions.h"
 #include "compute/vulkan/VulkanContext.h"
 #include "compute/vulkan/VulkanClosestRotations.h"
 #include "compute/vulkan/VulkanIdealMaps.h"
@@ -76,10 +76,7 @@ void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions&
   if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   const bool oneBinding = faceCount <= context_->info().maxStorageBufferRange / vk::kFaceMapBytes;
-  // Positions this backend computed (affinePositions) are bound where they are.
-  const vk::Array<double>* residentTarget =
-      target.rows() == source.rows() && target.cols() == 3 ? vk::arrayOf(target, *context_, vk::ArrayLayout::RowMajor)
-                                                           : nullptr;
+  const vk::Array<double>* residentTarget = residentPositions(target, source);
   Positions hostTarget;
   if (!residentTarget) hostTarget = target.values();
   const vk::Array<double>* fits = nullptr;
@@ -100,19 +97,41 @@ void VulkanBackend::fitIdealMapsOnDevice(const FaceList& faces, const Positions&
   }
 }
 
-void VulkanBackend::affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                                    const DeviceMatrix& mapColumns, const DeviceMatrix& previous,
-                                    AffinePositions& out) {
-  checkAffinePositionInputs(faces, base, corners, mapColumns, previous);
+void VulkanBackend::fitProjectiveMapsOnDevice(const FaceList& faces, const Positions& source,
+                                              const DeviceMatrix& target, double vanishingScale,
+                                              DeviceProjectiveFits& out) {
+  if (!projectiveFit_) projectiveFit_ = std::make_unique<vk::ProjectiveFitKernel>(*context_);
+  const vk::Array<double>* residentTarget = residentPositions(target, source);
+  Positions hostTarget;
+  if (!residentTarget) hostTarget = target.values();
+  if (projectiveFit_->keep(faces, source, residentTarget ? nullptr : &hostTarget, residentTarget, vanishingScale,
+                           out)) {
+    return;
+  }
+  // No faces, or more maps than one binding holds: the host keeps them.
+  Backend::fitProjectiveMapsOnDevice(faces, source, target, vanishingScale, out);
+}
+
+const vk::Array<double>* VulkanBackend::residentPositions(const DeviceMatrix& positions, const Positions& like) const {
+  // Positions this backend computed (mapPositions) are bound where they are.
+  return positions.rows() == like.rows() && positions.cols() == 3
+             ? vk::arrayOf(positions, *context_, vk::ArrayLayout::RowMajor)
+             : nullptr;
+}
+
+void VulkanBackend::mapPositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                                 const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights,
+                                 const DeviceMatrix& previous, MapPositions& out) {
+  checkMapPositionInputs(faces, base, corners, mapColumns, cornerWeights, previous);
   const std::size_t range = context_->info().maxStorageBufferRange;
   const auto largest = std::max<std::size_t>({static_cast<std::size_t>(mapColumns.size()),
                                               static_cast<std::size_t>(base.size()), corners.corners.size()});
   if (largest > range / sizeof(double)) {  // more than one binding holds: on the host
-    Backend::affinePositions(faces, base, corners, mapColumns, previous, out);
+    Backend::mapPositions(faces, base, corners, mapColumns, cornerWeights, previous, out);
     return;
   }
-  if (!affinePositions_) affinePositions_ = std::make_unique<vk::AffinePositionsKernel>(*context_);
-  affinePositions_->run(faces, base, corners, mapColumns, previous, out);
+  if (!mapPositions_) mapPositions_ = std::make_unique<vk::MapPositionsKernel>(*context_);
+  mapPositions_->run(faces, base, corners, mapColumns, cornerWeights, previous, out);
 }
 
 std::unique_ptr<SpdSolver> VulkanBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {

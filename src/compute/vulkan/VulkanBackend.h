@@ -12,7 +12,9 @@ class ProjectiveFitKernel;
 class ClosestRotationsKernel;
 class IdealMapsKernel;
 class ResidentFaceMaps;
-class AffinePositionsKernel;
+class MapPositionsKernel;
+template <class T>
+class Array;
 }  // namespace plano::vk
 
 namespace plano::compute {
@@ -43,12 +45,18 @@ class VulkanBackend final : public Backend {
                     IdealMaps& out) override;
   /// The fits and the ideal maps stay on the device (vk::ResidentFaceMaps): three tallies
   /// come back, and the maps only when their values are read.
-  /// A target of this backend's affinePositions is bound where it is.
+  /// A target of this backend's mapPositions is bound where it is.
   void fitIdealMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target, bool similar,
                             DeviceIdealMaps& out) override;
-  /// On the device (vk::AffinePositionsKernel): two scalars come back, the positions stay.
-  void affinePositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
-                       const DeviceMatrix& mapColumns, const DeviceMatrix& previous, AffinePositions& out) override;
+  /// The fits, their first three columns and the induced scales stay in the fit kernel's
+  /// arrays (vk::ProjectiveFitKernel::keep): two tallies come back. A target of this
+  /// backend's mapPositions is bound where it is.
+  void fitProjectiveMapsOnDevice(const FaceList& faces, const Positions& source, const DeviceMatrix& target,
+                                 double vanishingScale, DeviceProjectiveFits& out) override;
+  /// On the device (vk::MapPositionsKernel): two scalars come back, the positions stay.
+  void mapPositions(const FaceList& faces, const Positions& base, const VertexCorners& corners,
+                    const DeviceMatrix& mapColumns, const DeviceMatrix& cornerWeights, const DeviceMatrix& previous,
+                    MapPositions& out) override;
   /// A Jacobi-preconditioned CG solver on the device (vk::PcgSolver). It uses this
   /// backend's device: it must not outlive the backend.
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
@@ -69,6 +77,10 @@ class VulkanBackend final : public Backend {
   vk::Context& context() { return *context_; }
 
  private:
+  /// The array of `positions` when it holds this backend's positions of as many vertices
+  /// as `like` (mapPositions'); else null.
+  const vk::Array<double>* residentPositions(const DeviceMatrix& positions, const Positions& like) const;
+
   std::unique_ptr<vk::Context> context_;
   std::unique_ptr<vk::FacePlanarityKernel> planarity_;
   std::unique_ptr<vk::ProjectiveFitKernel> projectiveFit_;
@@ -77,7 +89,7 @@ class VulkanBackend final : public Backend {
   /// before the kernel, which releases it when destroyed).
   std::unique_ptr<vk::ResidentFaceMaps> residentMaps_;
   std::unique_ptr<vk::IdealMapsKernel> idealMaps_;
-  std::unique_ptr<vk::AffinePositionsKernel> affinePositions_;
+  std::unique_ptr<vk::MapPositionsKernel> mapPositions_;
 };
 
 /// Create the Vulkan backend. The device can be forced with the environment variable

@@ -1,10 +1,16 @@
 #include "compute/vulkan/VulkanDeviceMatrix.h"
 
+#include <atomic>
 #include <vector>
 
 #include "core/Error.h"
 
 namespace plano::vk {
+
+std::uint64_t nextArrayGeneration() {
+  static std::atomic<std::uint64_t> last{0};
+  return ++last;
+}
 
 ArraySource::ArraySource(const Context& context, const Array<double>& array, ArrayLayout layout, Eigen::Index rows,
                          Eigen::Index cols, std::uint64_t generation, std::weak_ptr<const std::uint64_t> live)
@@ -42,10 +48,14 @@ const Array<double>* ArraySource::arrayIn(const Context& context) const {
   return &context == &context_ && current() ? &array_ : nullptr;
 }
 
-const Array<double>* arrayOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout) {
+const ArraySource* arraySourceOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout) {
   const auto* source = dynamic_cast<const ArraySource*>(m.source());
-  if (!source || source->layout() != layout || m.factor() != 1.0) return nullptr;
-  return source->arrayIn(context);
+  return source && source->layout() == layout && source->arrayIn(context) ? source : nullptr;
+}
+
+const Array<double>* arrayOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout) {
+  const ArraySource* source = m.factor() == 1.0 ? arraySourceOf(m, context, layout) : nullptr;
+  return source ? source->arrayIn(context) : nullptr;
 }
 
 }  // namespace plano::vk

@@ -13,6 +13,10 @@ namespace plano::vk {
 /// One face map in a device array: 16 doubles, column-major (the fit and ideal-map kernels').
 inline constexpr std::size_t kFaceMapBytes = 16 * sizeof(double);
 
+/// A generation no array of this process has had before (never 0): the owners of device
+/// arrays give their contents such generations, so that one generation names one content.
+std::uint64_t nextArrayGeneration();
+
 /// How an array holds a rows x cols matrix.
 enum class ArrayLayout {
   ColumnMajor,  ///< Entry (r, c) at c * rows + r (DeviceVectors: the ADMM's x).
@@ -32,6 +36,7 @@ class ArraySource final : public compute::DeviceMatrixSource {
   /// The array when it still holds the values and belongs to `context`; else null.
   const Array<double>* arrayIn(const Context& context) const;
   ArrayLayout layout() const { return layout_; }
+  std::uint64_t generation() const { return generation_; }
 
  private:
   bool current() const;
@@ -42,6 +47,10 @@ class ArraySource final : public compute::DeviceMatrixSource {
   std::uint64_t generation_;
   std::weak_ptr<const std::uint64_t> live_;
 };
+
+/// The source of `m` when it is an ArraySource of `context` in `layout`, still current
+/// (whatever m's factor); else null.
+const ArraySource* arraySourceOf(const compute::DeviceMatrix& m, const Context& context, ArrayLayout layout);
 
 /// The array of `m` when its source is an ArraySource of `context` in `layout`, still
 /// current, with factor 1; else null.

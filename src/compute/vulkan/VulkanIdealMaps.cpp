@@ -28,7 +28,7 @@ void ResidentFaceMaps::hold(const Context& context, const Array<double>& array, 
   array_ = &array;
   faceCount_ = faceCount;
   maps_ = std::move(maps);
-  *liveGeneration_ = ++generation_;
+  *liveGeneration_ = generation_ = nextArrayGeneration();
   source_.reset();
 }
 
@@ -36,7 +36,7 @@ void ResidentFaceMaps::release() {
   array_ = nullptr;
   faceCount_ = 0;
   maps_.clear();
-  *liveGeneration_ = ++generation_;
+  *liveGeneration_ = generation_ = nextArrayGeneration();
   source_.reset();
 }
 
@@ -49,11 +49,6 @@ const Array<double>* ResidentFaceMaps::holdingNegatedColumns(const Eigen::Matrix
     if (q.middleRows<4>(row) != -maps_[f].leftCols(q.cols())) return nullptr;  // exact: negation rounds nothing
   }
   return array_;
-}
-
-const Array<double>* ResidentFaceMaps::holdingColumns(const compute::DeviceMatrix& m, double factor) const {
-  // source_ is this generation's (hold and release reset it).
-  return source_ && m.source() == source_.get() && m.factor() == factor ? array_ : nullptr;
 }
 
 std::shared_ptr<const compute::DeviceMatrixSource> ResidentFaceMaps::columnsSource() const {

@@ -17,7 +17,8 @@ namespace plano::vk {
 /// and its warm start x = T are then formed from the array on the device instead of
 /// uploaded (vk::AdmmKernels::start). Two ways to say "exactly those maps":
 ///  - a DeviceMatrix whose source is this record's columnsSource() of the current
-///    generation (a loop that never fetched the maps: nothing mesh-sized crossed);
+///    generation (a loop that never fetched the maps: nothing mesh-sized crossed; the ADMM
+///    binds any such face-map source of its context, the projective fits' too);
 ///  - host values equal to the host copy the kernel gave when it also downloaded the maps
 ///    (128 B a face, as exact comparison needs the values, not a digest).
 class ResidentFaceMaps {
@@ -30,8 +31,6 @@ class ResidentFaceMaps {
   /// The array when `q` (n x k, k <= 4) is, entry for entry, minus the first k columns of
   /// the held maps stacked four rows a face (q(4 f + r, c) = -M_f(r, c)); else null.
   const Array<double>* holdingNegatedColumns(const Eigen::MatrixXd& q) const;
-  /// The array when `m` is `factor` times columnsSource()'s matrix of the maps held now.
-  const Array<double>* holdingColumns(const compute::DeviceMatrix& m, double factor) const;
   /// The held maps' first three columns (4 #F x 3) as a device matrix's source
   /// (ArrayLayout::FaceMapColumns): fetched from the array while this record holds them
   /// (Error(Usage) after).

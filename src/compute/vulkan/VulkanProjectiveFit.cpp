@@ -5,6 +5,7 @@
 
 #include "compute/vulkan/VulkanDeviceMatrix.h"
 #include "compute/vulkan/VulkanInputChecks.h"
+#include "compute/vulkan/VulkanLinearAlgebra.h"
 #include "core/Error.h"
 
 namespace plano::vk {
@@ -22,6 +23,11 @@ static_assert(sizeof(int) == sizeof(std::int32_t), "ranks are 32-bit on the devi
 // Workgroup size of shaders/projective_fit.comp (FIT_GROUP_SIZE).
 constexpr std::uint32_t kFitGroupSize = 64;
 
+struct InducedScalesPush {
+  std::uint32_t faceCount;
+  std::uint32_t unused;
+  double vanishingScale;
+};
 
 }  // namespace
 
@@ -49,6 +55,7 @@ const Array<double>* ProjectiveFitKernel::runResidentOn(const FaceList& faces, c
 bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, const Positions* target,
                               const Array<double>* residentTarget, compute::ProjectiveFits* out) {
   if (target) compute::checkFitInputs(source, *target);
+  *mapsGeneration_ = nextArrayGeneration();  // maps_ is rewritten (or reallocated) below
   const std::size_t faceCount = static_cast<std::size_t>(faces.size());
   if (out) {
     out->maps.resize(faceCount);
@@ -115,6 +122,49 @@ bool ProjectiveFitKernel::fit(const FaceList& faces, const Positions& source, co
     first = last;
   }
   if (out && chunkEnds.size() == 1) lastMaps_ = out->maps;  // maps_ holds them all
+  return true;
+}
+
+bool ProjectiveFitKernel::keep(const FaceList& faces, const Positions& source, const Positions* target,
+                               const Array<double>* residentTarget, double vanishingScale,
+                               compute::DeviceProjectiveFits& out) {
+  if (!target && (!residentTarget || residentTarget->count() < static_cast<std::size_t>(source.size()))) {
+    throwUsage("fitProjectiveMaps: the device's target positions are fewer than the source's");
+  }
+  out = compute::DeviceProjectiveFits{};
+  const std::size_t faceCount = static_cast<std::size_t>(faces.size());
+  if (faceCount == 0 || !fit(faces, source, target, residentTarget, nullptr)) return false;
+  const std::uint32_t corners = elementCount(faces.cornerCount(), "the corner count");
+  if (!inducedScales_) {
+    inducedScales_ = std::make_unique<Pipeline>(context_, "induced_scales", 6, sizeof(InducedScalesPush));
+  }
+  *scalesGeneration_ = nextArrayGeneration();
+  ensureCapacity(cornerScales_, context_, corners, "induced reciprocal scales");
+  ensureCapacity(scaleTallies_, context_, 2, "induced scale tallies");
+  Sequence s(context_);
+  s.begin();
+  s.zero(scaleTallies_, 2 * sizeof(std::uint32_t));
+  s.dispatch(*inducedScales_,
+             {BufferRange(source_.array(), 0, static_cast<std::size_t>(source.size()) * sizeof(double)),
+              BufferRange(offsets_.array()), BufferRange(indices_.array()),
+              BufferRange(maps_, 0, faceCount * kFaceMapBytes), BufferRange(cornerScales_, 0, corners * sizeof(double)),
+              BufferRange(scaleTallies_)},
+             InducedScalesPush{static_cast<std::uint32_t>(faceCount), 0, vanishingScale}, groupsFor(context_, faceCount));
+  s.end();
+  s.run();
+  std::uint32_t tally[2] = {};
+  scaleTallies_.download({tally, 2});
+  out.nonPositiveScales = static_cast<Index>(tally[0]);
+  out.firstVanishingCorner = tally[1] > 0 ? static_cast<Index>(0xffffffffu - tally[1]) : -1;
+  const auto rows = 4 * static_cast<Eigen::Index>(faceCount);
+  out.linearColumns = compute::DeviceMatrix(
+      rows, 3,
+      std::make_shared<const ArraySource>(context_, maps_, ArrayLayout::FaceMapColumns, rows, 3, *mapsGeneration_,
+                                          mapsGeneration_));
+  out.reciprocalScales = compute::DeviceMatrix(
+      corners, 1,
+      std::make_shared<const ArraySource>(context_, cornerScales_, ArrayLayout::ColumnMajor, corners, 1,
+                                          *scalesGeneration_, scalesGeneration_));
   return true;
 }
 

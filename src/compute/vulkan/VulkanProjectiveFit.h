@@ -2,6 +2,8 @@
 // Batched projective fits (projective-maps paper §4.1, Eq. 3) on the device:
 // shaders/projective_fit.comp, the math of src/projective/LocalFit.cpp, one invocation
 // per face, fp64.
+#include <memory>
+
 #include "compute/Backend.h"
 #include "compute/vulkan/VulkanSequence.h"
 
@@ -28,8 +30,17 @@ class ProjectiveFitKernel {
   /// no face count as resident (`mapsHolding` holds nothing after it).
   const Array<double>* runResident(const FaceList& faces, const Positions& source, const Positions& target);
   /// runResident with the target positions in a device array of this context (#V x 3,
-  /// row-major: vk::AffinePositionsKernel's), bound instead of uploaded.
+  /// row-major: vk::MapPositionsKernel's), bound instead of uploaded.
   const Array<double>* runResidentOn(const FaceList& faces, const Positions& source, const Array<double>& target);
+
+  /// runResident (with the target in `target`, or in `residentTarget` when `target` is
+  /// null) for a projective global step (compute::Backend::fitProjectiveMapsOnDevice): the
+  /// maps' first three columns and the corners' induced reciprocal scales on `source`
+  /// (shaders/induced_scales.comp) stay on the device as device matrices, and their tallies
+  /// (8 bytes) come back. Both matrices are readable until the next run. False, with
+  /// nothing run, where runResident would return null.
+  bool keep(const FaceList& faces, const Positions& source, const Positions* target, const Array<double>* residentTarget,
+            double vanishingScale, compute::DeviceProjectiveFits& out);
 
   /// The device array of the last run's maps (16 doubles a face, column-major) when it
   /// holds exactly `maps` (a run of one chunk), else null; and that of its targets when
@@ -55,6 +66,13 @@ class ProjectiveFitKernel {
   CachedArray<Index> offsets_, indices_;
   Array<double> maps_, scales_, residuals_;
   Array<std::int32_t> ranks_;
+  /// keep()'s: the induced scales, their tallies, and the generations of what maps_ and
+  /// inducedScales_ hold (every run rewrites maps_).
+  std::unique_ptr<Pipeline> inducedScales_;
+  Array<double> cornerScales_;
+  Array<std::uint32_t> scaleTallies_;
+  std::shared_ptr<std::uint64_t> mapsGeneration_ = std::make_shared<std::uint64_t>(0);
+  std::shared_ptr<std::uint64_t> scalesGeneration_ = std::make_shared<std::uint64_t>(0);
 };
 
 }  // namespace plano::vk

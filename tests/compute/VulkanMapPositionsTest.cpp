@@ -1,4 +1,4 @@
-// Vulkan positions from affine face maps (Backend::affinePositions) against the CPU
+// Vulkan positions from affine face maps (Backend::mapPositions) against the CPU
 // reference, with the displacement and planarity measured on the device: positions to
 // 1e-12, the same measures, only two scalars back, and the positions bound where they are.
 #include <gtest/gtest.h>
@@ -30,9 +30,9 @@ Eigen::MatrixXd perturbedIdealColumns(const projective::ShapeSpace& space, unsig
   return columns;
 }
 
-class VulkanAffinePositions : public VulkanTest {};
+class VulkanMapPositions : public VulkanTest {};
 
-TEST_F(VulkanAffinePositions, AgreeWithTheCpuAndOnlyTheirMeasuresComeBack) {
+TEST_F(VulkanMapPositions, AgreeWithTheCpuAndOnlyTheirMeasuresComeBack) {
   for (const PolygonMesh& mesh : {generate::translationalSurface(7, 5), generate::hexagonalDome(2)}) {
     const projective::ShapeSpace space(mesh);
     const compute::VertexCorners corners = space.vertexCorners();
@@ -41,16 +41,16 @@ TEST_F(VulkanAffinePositions, AgreeWithTheCpuAndOnlyTheirMeasuresComeBack) {
     const Eigen::MatrixXd start = Eigen::MatrixXd(space.basePositions());
 
     compute::CpuBackend cpu;
-    compute::AffinePositions cpuFirst, cpuSecond, gpuFirst, gpuSecond;
-    cpu.affinePositions(mesh.faces, space.basePositions(), corners, first, start, cpuFirst);
-    cpu.affinePositions(mesh.faces, space.basePositions(), corners, second, cpuFirst.positions, cpuSecond);
-    backend().affinePositions(mesh.faces, space.basePositions(), corners, first, start, gpuFirst);
+    compute::MapPositions cpuFirst, cpuSecond, gpuFirst, gpuSecond;
+    cpu.mapPositions(mesh.faces, space.basePositions(), corners, first, {}, start, cpuFirst);
+    cpu.mapPositions(mesh.faces, space.basePositions(), corners, second, {}, cpuFirst.positions, cpuSecond);
+    backend().mapPositions(mesh.faces, space.basePositions(), corners, first, {}, start, gpuFirst);
     EXPECT_FALSE(gpuFirst.positions.onHost());
 
     // The second step reads the first's positions where they are: up only the columns,
     // down the two measures.
     const vk::TransferCounts before = context().transfers();
-    backend().affinePositions(mesh.faces, space.basePositions(), corners, second, gpuFirst.positions, gpuSecond);
+    backend().mapPositions(mesh.faces, space.basePositions(), corners, second, {}, gpuFirst.positions, gpuSecond);
     const vk::TransferCounts after = context().transfers();
     EXPECT_EQ(after.uploadedBytes - before.uploadedBytes, static_cast<std::uint64_t>(second.size()) * 8u);
     EXPECT_EQ(after.downloadedBytes - before.downloadedBytes, 16u);
@@ -67,15 +67,15 @@ TEST_F(VulkanAffinePositions, AgreeWithTheCpuAndOnlyTheirMeasuresComeBack) {
   }
 }
 
-TEST_F(VulkanAffinePositions, PositionsFromANewerStepReplaceTheOldestOnly) {
+TEST_F(VulkanMapPositions, PositionsFromANewerStepReplaceTheOldestOnly) {
   const PolygonMesh mesh = generate::translationalSurface(4, 4);
   const projective::ShapeSpace space(mesh);
   const compute::VertexCorners corners = space.vertexCorners();
   const Eigen::MatrixXd start = Eigen::MatrixXd(space.basePositions());
-  compute::AffinePositions a, b, c;
-  backend().affinePositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 1), start, a);
-  backend().affinePositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 2), a.positions, b);
-  backend().affinePositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 3), b.positions, c);
+  compute::MapPositions a, b, c;
+  backend().mapPositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 1), {}, start, a);
+  backend().mapPositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 2), {}, a.positions, b);
+  backend().mapPositions(mesh.faces, space.basePositions(), corners, perturbedIdealColumns(space, 3), {}, b.positions, c);
   try {
     (void)a.positions.values();  // its array now holds c's
     ADD_FAILURE() << "expected Error(Usage)";
@@ -86,7 +86,7 @@ TEST_F(VulkanAffinePositions, PositionsFromANewerStepReplaceTheOldestOnly) {
   EXPECT_EQ(c.positions.values().rows(), mesh.vertices.rows());
 }
 
-TEST_F(VulkanAffinePositions, NonFiniteMapsAreNumericalErrorsAndWrongSizesUsageErrorsOnBothBackends) {
+TEST_F(VulkanMapPositions, NonFiniteMapsAreNumericalErrorsAndWrongSizesUsageErrorsOnBothBackends) {
   const PolygonMesh mesh = generate::translationalSurface(3, 3);
   const projective::ShapeSpace space(mesh);
   const compute::VertexCorners corners = space.vertexCorners();
@@ -95,15 +95,15 @@ TEST_F(VulkanAffinePositions, NonFiniteMapsAreNumericalErrorsAndWrongSizesUsageE
   columns(5, 1) = std::nan("");
   compute::CpuBackend cpu;
   for (compute::Backend* on : {static_cast<compute::Backend*>(&backend()), static_cast<compute::Backend*>(&cpu)}) {
-    compute::AffinePositions out;
+    compute::MapPositions out;
     try {
-      on->affinePositions(mesh.faces, space.basePositions(), corners, columns, start, out);
+      on->mapPositions(mesh.faces, space.basePositions(), corners, columns, {}, start, out);
       ADD_FAILURE() << on->name() << ": expected Error(Numerical)";
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Numerical) << e.what();
     }
     try {
-      on->affinePositions(mesh.faces, space.basePositions(), corners, columns.topRows(8), start, out);
+      on->mapPositions(mesh.faces, space.basePositions(), corners, columns.topRows(8), {}, start, out);
       ADD_FAILURE() << on->name() << ": expected Error(Usage)";
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Usage) << e.what();

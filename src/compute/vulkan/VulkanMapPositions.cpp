@@ -1,4 +1,4 @@
-#include "compute/vulkan/VulkanAffinePositions.h"
+#include "compute/vulkan/VulkanMapPositions.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,9 +11,10 @@
 namespace plano::vk {
 namespace {
 
-struct AffinePositionsPush {
+struct MapPositionsPush {
   std::uint32_t vertexCount;
   std::uint32_t rows;
+  std::uint32_t weighted;
 };
 
 std::span<const double> positionValues(const Positions& positions) {
@@ -22,26 +23,26 @@ std::span<const double> positionValues(const Positions& positions) {
 
 }  // namespace
 
-AffinePositionsKernel::AffinePositionsKernel(Context& context)
+MapPositionsKernel::MapPositionsKernel(Context& context)
     : context_(context),
       algebra_(context),
-      positions_(context, "affine_positions", 8, sizeof(AffinePositionsPush)),
+      positions_(context, "map_positions", 9, sizeof(MapPositionsPush)),
       planarity_(context, "face_planarity", 4, sizeof(FacePlanarityPush)),
       generations_{std::make_shared<std::uint64_t>(0), std::make_shared<std::uint64_t>(0)} {}
 
-AffinePositionsKernel::~AffinePositionsKernel() = default;
+MapPositionsKernel::~MapPositionsKernel() = default;
 
-void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, const compute::VertexCorners& corners,
-                                const compute::DeviceMatrix& mapColumns, const compute::DeviceMatrix& previous,
-                                compute::AffinePositions& out) {
+void MapPositionsKernel::run(const FaceList& faces, const Positions& base, const compute::VertexCorners& corners,
+                             const compute::DeviceMatrix& mapColumns, const compute::DeviceMatrix& cornerWeights,
+                             const compute::DeviceMatrix& previous, compute::MapPositions& out) {
   const std::uint32_t vertexCount = elementCount(base.rows(), "the vertex count");
   if (vertexCount == 0) {
-    out = compute::AffinePositions{compute::DeviceMatrix(Eigen::MatrixXd(0, 3)), 0.0, 0.0};
+    out = compute::MapPositions{compute::DeviceMatrix(Eigen::MatrixXd(0, 3)), 0.0, 0.0};
     return;
   }
   const std::uint32_t faceCount = elementCount(faces.size(), "the face count");
   const std::uint32_t rows = elementCount(mapColumns.rows(), "the map columns' rows");
-  checkFaces(faces, static_cast<Index>(base.rows()), "affinePositions");
+  checkFaces(faces, static_cast<Index>(base.rows()), "mapPositions");
   checkMeshFitsOneBinding(faces, static_cast<Index>(base.rows()), context_.info().maxStorageBufferRange);
   const std::size_t positionCount = std::size_t{vertexCount} * 3;
 
@@ -60,6 +61,15 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
     uploadedColumns_.upload({values.data(), static_cast<std::size_t>(values.size())});
     columns = &uploadedColumns_;
   }
+  // Weights: the fit kernel's induced scales; none for affine maps (a bound, unread array).
+  const bool weighted = cornerWeights.size() != 0;
+  const Array<double>* weights = weighted ? arrayOf(cornerWeights, context_, ArrayLayout::ColumnMajor) : columns;
+  if (!weights) {
+    const Eigen::MatrixXd& values = cornerWeights.values();
+    ensureCapacity(uploadedWeights_, context_, static_cast<std::size_t>(values.size()), "corner weights");
+    uploadedWeights_.upload({values.data(), static_cast<std::size_t>(values.size())});
+    weights = &uploadedWeights_;
+  }
   const Array<double>* before = arrayOf(previous, context_, ArrayLayout::RowMajor);
   if (before == &outputs_[next_]) next_ = 1 - next_;  // never write over the positions read
   if (!before) {
@@ -70,7 +80,7 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   }
 
   Array<double>& output = outputs_[next_];
-  ++*generations_[next_];  // what this array held is overwritten below
+  *generations_[next_] = nextArrayGeneration();  // what this array held is overwritten below
   ensureCapacity(output, context_, positionCount, "vertex positions");
   if (!distance_ || distance_->n() != vertexCount) {
     distance_ = std::make_unique<DeviceVectors>(context_, vertexCount, 1, "vertex displacements");
@@ -87,8 +97,8 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
              {BufferRange(*columns, 0, std::max<std::size_t>(rows, 1) * 3 * sizeof(double)), BufferRange(base_.array()),
               BufferRange(vertexOffsets_.array()), BufferRange(vertexCorners_.array()), BufferRange(cornerFace_.array()),
               BufferRange(*before, 0, positionCount * sizeof(double)), BufferRange(output, 0, positionCount * sizeof(double)),
-              BufferRange(distance_->data())},
-             AffinePositionsPush{vertexCount, rows}, groupsFor(context_, vertexCount));
+              BufferRange(distance_->data()), BufferRange(*weights)},
+             MapPositionsPush{vertexCount, rows, weighted ? 1u : 0u}, groupsFor(context_, vertexCount));
   s.barrier();
   if (faceCount > 0) {
     s.dispatch(planarity_,
@@ -106,7 +116,7 @@ void AffinePositionsKernel::run(const FaceList& faces, const Positions& base, co
   out.maxPlanarity = faceCount > 0 ? measures_->at(measured, 1, 0) : 0.0;
   // A non-finite position makes its distance non-finite (the reduction keeps NaN).
   if (!std::isfinite(out.displacement)) {
-    throwNumerical("affinePositions: a vertex position from the maps is not finite");
+    throwNumerical("mapPositions: a vertex position from the maps is not finite");
   }
   const auto vertexRows = static_cast<Eigen::Index>(vertexCount);
   out.positions = compute::DeviceMatrix(

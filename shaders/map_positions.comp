@@ -1,8 +1,11 @@
 #version 450
-// Vertex positions of affine face maps (projective/ShapeSpace::normalizedPositions with
-// fourth columns (0, 0, 0, 1), so every corner image's weight is 1): each vertex the mean
-// of its corner images (p, 1) A_f over the faces that share it, an isolated vertex its base
-// position; with each vertex's distance to its previous position (the loop's displacement).
+// Vertex positions of face maps (projective/ShapeSpace::normalizedPositions): each vertex
+// the mean of its dehomogenized corner images over the faces that share it, an isolated
+// vertex its base position; with each vertex's distance to its previous position (the
+// loop's displacement). A corner image is (p, 1) A_f: its first three coordinates from the
+// map's first three columns, its weight (p, 1) . a4 the corner's reciprocal scale
+// (shaders/induced_scales.comp) when the maps are projective, 1 when they are affine
+// (fourth columns (0, 0, 0, 1): pc.weighted = 0, the weights' binding unread).
 // One invocation per vertex; the corner images are summed in the host's order.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -17,10 +20,12 @@ layout(std430, binding = 4) readonly buffer CornerFace { int cornerFace[]; };  /
 layout(std430, binding = 5) readonly buffer Previous { double previous[]; };   // #V x 3, row-major
 layout(std430, binding = 6) writeonly buffer Positions { double positions[]; };  // #V x 3, row-major
 layout(std430, binding = 7) writeonly buffer Distance { double distance[]; };    // #V
+layout(std430, binding = 8) readonly buffer Weights { double weights[]; };       // per corner
 
 layout(push_constant) uniform Push {
   uint vertexCount;
   uint rows;  // 4 #F: the columns' stride
+  uint weighted;
 } pc;
 
 void main() {
@@ -32,12 +37,14 @@ void main() {
     if (end > begin) {
       precise dvec3 sum = dvec3(0.0LF);
       for (int k = begin; k < end; ++k) {
-        const uint row = 4u * uint(cornerFace[corners[k]]);
+        const int corner = corners[k];
+        const uint row = 4u * uint(cornerFace[corner]);
         precise dvec3 image;
         for (uint c = 0u; c < 3u; ++c) {
           const uint at = c * pc.rows + row;
           image[c] = (p.x * columns[at] + p.y * columns[at + 1u]) + (p.z * columns[at + 2u] + p.w * columns[at + 3u]);
         }
+        if (pc.weighted != 0u) image /= weights[corner];
         sum += image;
       }
       precise dvec3 mean = sum / double(end - begin);
