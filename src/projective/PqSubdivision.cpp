@@ -5,6 +5,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/Timing.h"
+#include "projective/GlobalStep.h"
 #include "projective/LocalStep.h"
 #include "projective/ShapeSpace.h"
 
@@ -26,23 +27,31 @@ void checkSettings(const PqSubdivisionSettings& settings) {
 }
 
 /// The local/global iterations of one level (§5 steps 1-4), from the trivially refined
-/// base towards the targets; returns the final positions.
+/// base towards the targets; returns the final positions. The positions (normalized), the
+/// fits and the global step's solution stay where the backend computes them: on a device
+/// an iteration moves no mesh-sized data (scalars come back).
 Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, const Positions& targets,
                          const PqSubdivisionSettings& settings, const PqIterationCallback& callback,
                          PqLevelInfo& info) {
   const ShapeSpace space(refined);
   GlobalStep global(backend, space, {}, settings.globalStep);
+  // The change is measured against the targets' diagonal; the positions' displacements come
+  // in normalized units (the base's diagonal).
   const double diagonal = boundingBoxDiagonal(targets);
-  Positions previous = targets;
-  Positions target = targets;
-  FaceMaps maps;
-  PolygonMesh current{targets, refined.faces};
+  const double toChange = diagonal > 0.0 ? space.normalization().scale / diagonal : 0.0;
+  const compute::VertexCorners corners = space.vertexCorners();
+  compute::DeviceMatrix current(Eigen::MatrixXd(normalizedTargetPositions(space, targets)));
   for (int iteration = 0; iteration < settings.maxIterationsPerLevel; ++iteration) {
     throwIfCancelled("subdivision");
     const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
-    const LocalStepResult local = fitFaceMaps(backend, space, target);
-    const GlobalStepInfo step = global.solve(local.fits.maps, Positions(), maps);
-    current.vertices = space.positions(maps.maps);
+    compute::DeviceProjectiveFits fits;
+    backend.fitProjectiveMapsOnDevice(space.faces(), space.basePositions(), current,
+                                      GlobalStep::kMinimumReciprocalScale, fits);
+    compute::DeviceMatrix columns;
+    const GlobalStepInfo step = global.solve(fits, Positions(), columns);
+    compute::MapPositions next;
+    backend.mapPositions(space.faces(), space.basePositions(), corners, columns, fits.reciprocalScales, current, next);
+    current = std::move(next.positions);
 
     PqIteration record;
     record.epsilon = step.epsilon;
@@ -50,8 +59,8 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     record.admmIterations = step.admmIterations;
     record.linearIterations = step.linearIterations;
     record.attempts = step.attempts;
-    record.maxPlanarity = planarityOf(backend, current, settings.planarityTolerance).max;
-    record.maxChange = diagonal > 0.0 ? maxVertexDistance(current.vertices, previous) / diagonal : 0.0;
+    record.maxPlanarity = next.maxPlanarity;
+    record.maxChange = next.displacement * toChange;
     record.transfers = compute::transfersSince(transfersBefore, backend.transfers());
     info.iterations.push_back(record);
     if (callback) callback(info.level, iteration + 1, info.iterations.back());
@@ -59,10 +68,8 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
       info.converged = true;
       break;
     }
-    previous = current.vertices;
-    target = current.vertices;
   }
-  return current.vertices;
+  return space.normalization().toWorld(Positions(current.values()));
 }
 
 }  // namespace
