@@ -179,15 +179,29 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     FaceMaps fineMaps;
     info.fineStep = fineStep.solve(prolonged, targets, fineMaps);
     result.positions = fineSpace.positions(fineMaps.maps);
-    // Only if eps > 0 left the faces above the bound: §5 projection iterations.
+    // Only if eps > 0 left the faces above the bound: §5 projection iterations, on the
+    // fine mesh's normalized positions where the backend computes them (on a device the
+    // fits, the solution and the positions stay there; the positions come back at the end).
     const double bound = std::max(settings.planarityTolerance, planarityStats(fineMesh).max);
-    for (int it = 0; it < settings.maxProjectionIterations &&
-                     planarityStats(PolygonMesh{result.positions, fineMesh.faces}).max > bound;
-         ++it) {
-      const LocalStepResult fit = fitFaceMaps(backend, fineSpace, result.positions);
-      fineStep.solve(fit.fits.maps, targets, fineMaps);
-      result.positions = fineSpace.positions(fineMaps.maps);
-      ++info.projectionIterations;
+    double planarity = planarityStats(PolygonMesh{result.positions, fineMesh.faces}).max;
+    if (settings.maxProjectionIterations > 0 && planarity > bound) {
+      const compute::VertexCorners corners = fineSpace.vertexCorners();
+      compute::DeviceMatrix current(Eigen::MatrixXd(normalizedTargetPositions(fineSpace, result.positions)));
+      for (int it = 0; it < settings.maxProjectionIterations && planarity > bound; ++it) {
+        throwIfCancelled("multi-resolution deformation (projection)");
+        compute::DeviceProjectiveFits fits;
+        backend.fitProjectiveMapsOnDevice(fineSpace.faces(), fineSpace.basePositions(), current,
+                                          GlobalStep::kMinimumReciprocalScale, fits);
+        compute::DeviceMatrix columns;
+        fineStep.solve(fits, targets, columns);
+        compute::MapPositions next;
+        backend.mapPositions(fineSpace.faces(), fineSpace.basePositions(), corners, columns, fits.reciprocalScales,
+                             current, next);
+        current = std::move(next.positions);
+        planarity = next.maxPlanarity;
+        ++info.projectionIterations;
+      }
+      result.positions = fineSpace.normalization().toWorld(Positions(current.values()));
     }
     info.prolongationSeconds = secondsSince(fineStart);
   }
