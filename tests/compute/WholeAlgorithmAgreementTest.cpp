@@ -187,6 +187,43 @@ TEST_F(WholeAlgorithmAgreement, MultiresDeformationGivesTheCpuMeshWithTheSameIte
   EXPECT_LT(relativeDifference(result.positions, reference.positions), kAgreement);
 }
 
+TEST_F(WholeAlgorithmAgreement, MultiresProjectionIterationsGiveTheCpuMeshWithTheSameIterations) {
+  // The paper's eps schedule from its relaxed start leaves the prolonged fine faces bent:
+  // projection iterations (projective fits of the fine faces, projected with the fine
+  // constraints) run on the fine level, on the device with their fits, scales, solution
+  // and positions kept there.
+  compute::CpuBackend cpu;
+  projective::PqSubdivisionSettings subdivision;
+  subdivision.levels = 1;
+  subdivision.planarityTolerance = 0.5;
+  const projective::PqSubdivisionResult hierarchy =
+      projective::subdividePlanarQuads(cpu, generate::translationalSurface(3, 3), subdivision);
+  const Positions& finest = hierarchy.positions.back();
+  PositionalConstraints constraints;
+  const double yMin = finest.col(1).minCoeff();
+  for (Index v = 0; v < finest.rows(); ++v) {
+    if (finest(v, 1) < yMin + 1e-9) constraints.fixed.push_back(v);
+  }
+  Index corner = 0;
+  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
+  constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.3)});
+  projective::MultiresSettings settings;
+  settings.level = 0;
+  settings.global.epsilonStart = projective::EpsilonStart::Relaxed;
+  settings.planarityTolerance = 1e-6;  // percent: below what the relaxed fine step leaves
+  settings.maxProjectionIterations = 3;
+
+  const projective::MultiresResult reference =
+      projective::multiresDeform(cpu, hierarchy.hierarchy, hierarchy.positions, constraints, settings);
+  const projective::MultiresResult result =
+      projective::multiresDeform(backend(), hierarchy.hierarchy, hierarchy.positions, constraints, settings);
+  ASSERT_GT(reference.info.projectionIterations, 0) << "the case must exercise the projection iterations";
+  EXPECT_EQ(result.info.projectionIterations, reference.info.projectionIterations);
+  EXPECT_EQ(result.info.coarseIterations, reference.info.coarseIterations);
+  EXPECT_EQ(result.info.status, reference.info.status);
+  EXPECT_LT(relativeDifference(result.positions, reference.positions), kAgreement);
+}
+
 TEST_F(WholeAlgorithmAgreement, SubspaceDeformationGivesTheCpuMeshWithTheSameIterations) {
   // A vertical-space dome, its first ring fixed and one vertex pulled up: 28 free
   // dimensions, ~25 iterations to the default tolerance (more than one device block).
