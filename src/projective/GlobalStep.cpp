@@ -174,7 +174,6 @@ GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumn
 
 GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute::DeviceMatrix& shat,
                                    const Positions& positions, compute::DeviceMatrix& x) {
-  const Index faceCount = space_.faceCount();
   if (!constrained_.empty() && positions.rows() != static_cast<Eigen::Index>(constrained_.size())) {
     throwUsage("global step: " + std::to_string(positions.rows()) + " positions for " +
                std::to_string(constrained_.size()) + " constrained vertices");
@@ -215,30 +214,37 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
   compute::RelaxedBounds bounds{std::move(d), std::vector<char>(m), 0.0};
   for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
 
+  solveEpsilonSchedule(qp, T, bounds, settings_, "global step", info, x);
+  return info;
+}
+
+void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compute::RelaxedBounds& bounds,
+                          const GlobalStepSettings& settings, const std::string& what, GlobalStepInfo& info,
+                          compute::DeviceMatrix& x) {
   // q = -T; measured where the QP runs, which keeps q and d for the attempts.
   const compute::DeviceMatrix q = T.negated();
-  info.initialViolation = m > 0 ? qp.violationAt(q, bounds, T) : 0.0;
+  info.initialViolation = bounds.centre.rows() > 0 ? qp.violationAt(q, bounds, T) : 0.0;
   if (!std::isfinite(info.initialViolation)) {  // d is finite: a target is not
     const Eigen::MatrixXd& values = T.values();
-    for (Index f = 0; f < faceCount; ++f) {
+    for (Eigen::Index f = 0; f < values.rows() / 4; ++f) {
       if (!values.middleRows<4>(4 * f).allFinite()) {
-        throwNumerical("global step: the target map of face " + std::to_string(f) + " is not finite");
+        throwNumerical(what + ": the target map of face " + std::to_string(f) + " is not finite");
       }
     }
-    throwNumerical("global step: the targets' constraint violation is not finite");
+    throwNumerical(what + ": the targets' constraint violation is not finite");
   }
 
   std::vector<double> schedule;
-  const double eps0 = settings_.initialEpsilonFraction * info.initialViolation;
-  if (settings_.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
+  const double eps0 = settings.initialEpsilonFraction * info.initialViolation;
+  if (settings.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
   if (eps0 > 0.0) {
     double eps = eps0;
-    for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
+    for (int i = 0; i <= settings.maxEpsilonIncreases; ++i, eps *= settings.epsilonGrowth) schedule.push_back(eps);
   }
 
   bool solved = false;
   for (double eps : schedule) {
-    throwIfCancelled("the global step");
+    throwIfCancelled(("the " + what).c_str());
     bounds.epsilon = eps;
     // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
     // (its certificate), a poor warm start for the next eps.
@@ -250,7 +256,7 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
     info.factorizations += qpInfo.factorizations;
     info.linearIterations += qpInfo.linearIterations;
     if (qpInfo.status == BoxQpStatus::NonFinite) {
-      throwNumerical("global step: the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
+      throwNumerical(what + ": the ADMM iteration produced a non-finite value (eps " + formatDouble(eps) + ")");
     }
     if (isSolved(qpInfo.status)) {
       x = std::move(xTry);
@@ -275,7 +281,7 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
     }
   }
   if (!solved) {
-    throwNumerical("global step: no feasible relaxation found; eps grew from " + formatDouble(schedule.front()) +
+    throwNumerical(what + ": no feasible relaxation found; eps grew from " + formatDouble(schedule.front()) +
                    " to " + formatDouble(schedule.back()) + " (initial violation " +
                    formatDouble(info.initialViolation) + ", " + std::to_string(info.admmIterations) +
                    " ADMM iterations)");
@@ -284,7 +290,6 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
   // Measured where the QP left x (its iterate, on a device: two scalars come back).
   info.constraintResidual = qp.centreDistance(x, bounds, true);
   info.positionalResidual = qp.centreDistance(x, bounds, false);
-  return info;
 }
 
 }  // namespace plano::projective

@@ -162,4 +162,17 @@ class GlobalStep {
   std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
 };
 
+/// The paper's ε schedule (§5) on a kept QP, the global steps' (this one's and the multires
+/// coarse step's): q = -T, the initial violation max |C T - bounds.centre| measured where
+/// the QP runs, eps_0 = initialEpsilonFraction times it (eps = 0 first for ExactFirst), then
+/// eps grows by epsilonGrowth until an attempt converges. Each attempt starts from the
+/// targets T (4 #F x 3, possibly a device matrix) with zero duals (the QP's settings must
+/// not return duals). x receives the accepted solution where the QP left it; info the
+/// violation, the attempts, their iteration counts and the solution's residuals. `what`
+/// names the step in errors: Error(Numerical) for a non-finite target (naming its face) or
+/// iterate, and for an exhausted schedule.
+void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compute::RelaxedBounds& bounds,
+                          const GlobalStepSettings& settings, const std::string& what, GlobalStepInfo& info,
+                          compute::DeviceMatrix& x);
+
 }  // namespace plano::projective

@@ -109,108 +109,79 @@ GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& tar
       throwNumerical("coarse global step: the target map of face " + std::to_string(f) + " is not finite");
     }
   }
-  GlobalStepInfo info;
   const std::vector<double> shat = space_.inducedReciprocalScales(targets);
+  Index nonPositive = 0;
   for (Index c = 0; c < space_.cornerCount(); ++c) {
-    if (shat[c] <= 0.0) ++info.nonPositiveScales;
+    if (shat[c] <= 0.0) ++nonPositive;
     if (!(std::abs(shat[c]) > GlobalStep::kMinimumReciprocalScale)) {
       throwNumerical("coarse global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
                      " sends vertex " + std::to_string(space_.faces().indices()[c]) + " to infinity");
     }
   }
-
-  const auto m = static_cast<Eigen::Index>(rows_.size());
-  const Index n = 4 * faceCount;
+  // Scales: the corners' reciprocal scale factors, then one per handle (its point's).
   std::vector<double> scales = shat;
-  scales.resize(shat.size() + handles_.size());
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
-  std::vector<char> relaxed(m, 0);
-  for (Eigen::Index r = 0; r < m; ++r) {
-    const Row& row = rows_[r];
-    if (row.kind == RowKind::MapPoint) {
-      const MapPointConstraint& h = handles_[row.handle];
-      const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
-      const double scale = p.dot(targets[h.face].col(3).transpose());
-      if (!(std::abs(scale) > GlobalStep::kMinimumReciprocalScale)) {
-        throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
-                       std::to_string(h.handle) + " to infinity");
-      }
-      scales[shat.size() + row.handle] = scale;
-      d.row(r) = h.target.transpose();
-    } else if (row.kind == RowKind::Compatibility) {
-      relaxed[r] = 1;
-    } else {
-      d.row(r) = space_.basePositions().row(row.vertex);
+  scales.reserve(shat.size() + handles_.size());
+  for (const MapPointConstraint& h : handles_) {
+    const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
+    const double scale = p.dot(targets[h.face].col(3).transpose());
+    if (!(std::abs(scale) > GlobalStep::kMinimumReciprocalScale)) {
+      throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
+                     std::to_string(h.handle) + " to infinity");
     }
+    scales.push_back(scale);
   }
-  const compute::SparseMatrix& C = constraints_.fill(scales);
-
-  Eigen::MatrixXd T(n, 3);
+  Eigen::MatrixXd T(4 * faceCount, 3);
   for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
-  const Eigen::MatrixXd q = -T;
-  info.initialViolation = m > 0 ? (C * T - d).cwiseAbs().maxCoeff() : 0.0;
-
-  // The paper's schedule (§5): eps_0 = fraction * violation, times the growth until the
-  // relaxed problem is solved; optionally eps = 0 first.
-  std::vector<double> schedule;
-  const double eps0 = settings_.initialEpsilonFraction * info.initialViolation;
-  if (settings_.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
-  if (eps0 > 0.0) {
-    double eps = eps0;
-    for (int i = 0; i <= settings_.maxEpsilonIncreases; ++i, eps *= settings_.epsilonGrowth) schedule.push_back(eps);
-  }
-
-  // C's pattern depends on the topology (and the constrained vertices) only: one solver
-  // for the object's lifetime.
-  BoxQpSettings qpSettings = settings_.qp;
-  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
-  Eigen::MatrixXd x = T;
-  Eigen::MatrixXd y;
-  bool solved = false;
-  compute::RelaxedBounds bounds{d, relaxed, 0.0};
-  for (const double eps : schedule) {
-    bounds.epsilon = eps;
-    Eigen::MatrixXd xTry = x;
-    Eigen::MatrixXd yTry = y;
-    const BoxQpInfo qpInfo = qp.solve(q, bounds, xTry, yTry);
-    info.attempts.push_back({eps, qpInfo.status, qpInfo.iterations, qpInfo.direct});
-    info.admmIterations += qpInfo.iterations;
-    info.factorizations += qpInfo.factorizations;
-    info.linearIterations += qpInfo.linearIterations;
-    if (qpInfo.status == BoxQpStatus::NonFinite) {
-      throwNumerical("coarse global step: the ADMM iteration produced a non-finite value (eps " + number(eps) + ")");
-    }
-    x = xTry;
-    y = yTry;  // the next eps starts from this attempt
-    if (isSolved(qpInfo.status)) {
-      info.epsilon = eps;
-      info.polished = qpInfo.polished;
-      info.polishRefinements = qpInfo.polishRefinements;
-      info.status = startWasOptimal(qpInfo) ? GlobalStepStatus::Unchanged : GlobalStepStatus::Solved;
-      solved = true;
-      break;
-    }
-  }
-  if (!solved) {
-    throwNumerical("coarse global step: no feasible relaxation found up to eps " + number(schedule.back()) +
-                   " (initial violation " + number(info.initialViolation) + ")");
-  }
-
-  if (m > 0) {
-    const Eigen::MatrixXd residual = (C * x - d).cwiseAbs();
-    for (Eigen::Index r = 0; r < m; ++r) {
-      const double value = residual.row(r).maxCoeff();
-      info.constraintResidual = std::max(info.constraintResidual, value);
-      if (!relaxed[r]) info.positionalResidual = std::max(info.positionalResidual, value);
-    }
-  }
+  compute::DeviceMatrix columns;
+  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), scales, columns);
+  info.nonPositiveScales = nonPositive;
+  const Eigen::MatrixXd& x = columns.values();
   result.maps.resize(faceCount);
   for (Index f = 0; f < faceCount; ++f) {
     result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
     result.maps[f].col(3) = targets[f].col(3);
   }
   result.reciprocalScales = shat;
+  return info;
+}
+
+GlobalStepInfo MultiresCoarseStep::solveAffine(const compute::DeviceMatrix& linearColumns,
+                                               compute::DeviceMatrix& resultColumns) {
+  const Index faceCount = space_.faceCount();
+  if (linearColumns.rows() != 4 * static_cast<Eigen::Index>(faceCount) || linearColumns.cols() != 3) {
+    throwUsage("coarse global step: affine targets of " + std::to_string(linearColumns.rows()) + " x " +
+               std::to_string(linearColumns.cols()) + " for " + std::to_string(faceCount) + " faces (need 4 #F x 3)");
+  }
+  // Fourth columns (0, 0, 0, 1): every corner's and every handle point's scale is 1.
+  const std::vector<double> scales(space_.cornerCount() + handles_.size(), 1.0);
+  return project(linearColumns, scales, resultColumns);
+}
+
+GlobalStepInfo MultiresCoarseStep::project(const compute::DeviceMatrix& T, std::span<const double> scales,
+                                           compute::DeviceMatrix& x) {
+  const auto m = static_cast<Eigen::Index>(rows_.size());
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
+  std::vector<char> relaxed(m, 0);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Row& row = rows_[r];
+    if (row.kind == RowKind::MapPoint) {
+      d.row(r) = handles_[row.handle].target.transpose();
+    } else if (row.kind == RowKind::Compatibility) {
+      relaxed[r] = 1;
+    } else {
+      d.row(r) = space_.basePositions().row(row.vertex);
+    }
+  }
+  constraints_.fill(scales);
+  // C's pattern depends on the topology (and the constraints) only: one solver for the
+  // object's lifetime.
+  BoxQpSettings qpSettings = settings_.qp;
+  qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
+  qpSettings.returnDuals = false;      // every attempt starts from zero duals
+  BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
+  GlobalStepInfo info;
+  compute::RelaxedBounds bounds{std::move(d), std::move(relaxed), 0.0};
+  solveEpsilonSchedule(qp, T, bounds, settings_, "coarse global step", info, x);
   return info;
 }
 

@@ -11,6 +11,7 @@
 // the targets, three QPs for columns 0..2 sharing one matrix (BoxQp.h), the paper's ε
 // schedule on the compatibility rows only.
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -36,8 +37,18 @@ class MultiresCoarseStep {
   /// satisfy the constraints. result: out, the maps and reciprocal scales. Throws
   /// Error(Numerical) as GlobalStep::solve does.
   GlobalStepInfo solve(const std::vector<Eigen::Matrix4d>& targets, FaceMaps& result);
+  /// The same for affine targets (ideal maps: fourth columns (0, 0, 0, 1)) by their first
+  /// three columns, 4 #F x 3, which may stay on the device that computed them; the result's
+  /// first three columns are left where the QP solved for them (GlobalStep::solveAffine's
+  /// contract: readable while this object lives and until its next solve). Throws as
+  /// solve(), and Error(Usage) for targets of the wrong size.
+  GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, compute::DeviceMatrix& resultColumns);
 
  private:
+  /// The solves after their target checks: T (4 #F x 3) the targets' first three columns,
+  /// scales the corners' reciprocal scales then the handle points'.
+  GlobalStepInfo project(const compute::DeviceMatrix& T, std::span<const double> scales, compute::DeviceMatrix& x);
+
   enum class RowKind { Compatibility, Fixed, MapPoint };
   struct Row {
     RowKind kind;

@@ -6,6 +6,7 @@
 #include "core/Error.h"
 #include "core/Timing.h"
 #include "projective/Deformation.h"
+#include "projective/IdealMaps.h"
 #include "projective/LocalStep.h"
 #include "projective/MultiresCoarseStep.h"
 #include "projective/ShapeSpace.h"
@@ -146,21 +147,33 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
     GlobalStepSettings coarseSettings = settings.global;
     coarseSettings.smoothness = 0.0;
     MultiresCoarseStep coarseStep(backend, coarseSpace, coarse.fixed, coarse.handles, coarseSettings);
-    Positions current = positions[level];
-    FaceMaps coarseMaps = coarseSpace.identityMaps();
+    // The coarse positions, normalized, where the backend computes them: on a device the
+    // ideal maps, the solution and these positions stay there (scalars come back); the
+    // last solution's maps come back once, for the prolongation.
+    const compute::VertexCorners coarseCorners = coarseSpace.vertexCorners();
+    compute::DeviceMatrix coarseCurrent(Eigen::MatrixXd(normalizedTargetPositions(coarseSpace, positions[level])));
+    compute::DeviceMatrix coarseColumns;  // the last solution's first three columns; empty: identity maps
     bool converged = false;
-    const double coarseDiagonal = coarseSpace.normalization().scale;
     for (int it = 0; it < settings.maxCoarseIterations && !converged; ++it) {
       throwIfCancelled("multi-resolution deformation");
-      const auto ideal = fittedIdealMaps(backend, coarseSpace, current, settings.energy);
-      const GlobalStepInfo step = coarseStep.solve(ideal, coarseMaps);
-      const Positions next = coarseSpace.positions(coarseMaps.maps);
-      const double displacement = maxVertexDistance(next, current) / coarseDiagonal;
+      const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
+      const compute::DeviceMatrix ideal = idealMapsOfNormalized(backend, coarseSpace, coarseCurrent, settings.energy);
+      compute::DeviceMatrix columns;
+      const GlobalStepInfo step = coarseStep.solveAffine(ideal, columns);
+      compute::MapPositions next;
+      backend.mapPositions(coarseSpace.faces(), coarseSpace.basePositions(), coarseCorners, columns, {}, coarseCurrent, next);
       info.coarseEpsilons.push_back(step.epsilon);
-      info.coarseDisplacements.push_back(displacement);
+      info.coarseDisplacements.push_back(next.displacement);  // normalized units: over the diagonal's scale
+      info.coarseTransfers.push_back(compute::transfersSince(transfersBefore, backend.transfers()));
       ++info.coarseIterations;
-      current = next;
-      converged = displacement < settings.tolerance;
+      coarseCurrent = std::move(next.positions);
+      coarseColumns = std::move(columns);
+      converged = next.displacement < settings.tolerance;
+    }
+    FaceMaps coarseMaps = coarseSpace.identityMaps();
+    if (info.coarseIterations > 0) {
+      const Eigen::MatrixXd& x = coarseColumns.values();
+      for (Index f = 0; f < coarseSpace.faceCount(); ++f) coarseMaps.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
     }
     if (!converged) info.status = MultiresStatus::MaxIterationsReached;
     info.coarseSeconds = secondsSince(coarseStart);
@@ -189,6 +202,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
       compute::DeviceMatrix current(Eigen::MatrixXd(normalizedTargetPositions(fineSpace, result.positions)));
       for (int it = 0; it < settings.maxProjectionIterations && planarity > bound; ++it) {
         throwIfCancelled("multi-resolution deformation (projection)");
+        const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
         compute::DeviceProjectiveFits fits;
         backend.fitProjectiveMapsOnDevice(fineSpace.faces(), fineSpace.basePositions(), current,
                                           GlobalStep::kMinimumReciprocalScale, fits);
@@ -199,6 +213,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
                              current, next);
         current = std::move(next.positions);
         planarity = next.maxPlanarity;
+        info.projectionTransfers.push_back(compute::transfersSince(transfersBefore, backend.transfers()));
         ++info.projectionIterations;
       }
       result.positions = fineSpace.normalization().toWorld(Positions(current.values()));

@@ -18,6 +18,7 @@
 // vertices are held where they are on their own level, and handles act on the ambient
 // space of the coarse maps in either case. When the rule picks the finest level, the
 // single-level deformation (Deformation.h) runs on M_n directly.
+#include <optional>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -69,6 +70,10 @@ struct MultiresInfo {
   int coarseIterations = 0;
   std::vector<double> coarseEpsilons;  ///< Per coarse global step.
   std::vector<double> coarseDisplacements;
+  /// Per coarse iteration and per projection iteration: the copies between host and device
+  /// (Backend::transfers; nullopt on a backend that does not count them).
+  std::vector<std::optional<compute::DeviceTransfers>> coarseTransfers;
+  std::vector<std::optional<compute::DeviceTransfers>> projectionTransfers;
   GlobalStepInfo fineStep;            ///< The prolongation's global step.
   int projectionIterations = 0;
   PlanarityStats planarity;           ///< Of the fine result.

@@ -25,11 +25,26 @@ nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>
   return list;
 }
 
+namespace {
+nlohmann::json transfersJson(const compute::DeviceTransfers& transfers) {
+  return {{"uploaded_bytes", transfers.uploadedBytes},
+          {"downloaded_bytes", transfers.downloadedBytes},
+          {"copies", transfers.copies}};
+}
+}  // namespace
+
 void addTransfers(nlohmann::json& entry, const std::optional<compute::DeviceTransfers>& transfers) {
-  if (!transfers) return;
-  entry["device_transfers"] = {{"uploaded_bytes", transfers->uploadedBytes},
-                               {"downloaded_bytes", transfers->downloadedBytes},
-                               {"copies", transfers->copies}};
+  if (transfers) entry["device_transfers"] = transfersJson(*transfers);
+}
+
+void addTransferList(nlohmann::json& entry, const std::string& key,
+                     const std::vector<std::optional<compute::DeviceTransfers>>& perIteration) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& transfers : perIteration) {
+    if (!transfers) return;
+    list.push_back(transfersJson(*transfers));
+  }
+  if (!list.empty()) entry[key] = std::move(list);
 }
 
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,

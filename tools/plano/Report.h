@@ -23,6 +23,10 @@ nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>
 /// Add `device_transfers` {uploaded_bytes, downloaded_bytes, copies} to an iteration's
 /// entry when the backend counted them (a device backend).
 void addTransfers(nlohmann::json& entry, const std::optional<compute::DeviceTransfers>& transfers);
+/// Add `key`: [{uploaded_bytes, downloaded_bytes, copies}], one per iteration, when the
+/// backend counted them.
+void addTransferList(nlohmann::json& entry, const std::string& key,
+                     const std::vector<std::optional<compute::DeviceTransfers>>& perIteration);
 
 /// The common keys of a report for a command that produced `mesh`.
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,

@@ -227,6 +227,8 @@ DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& glo
                                 {"coarse_deform", info.coarseSeconds},
                                 {"prolongation", info.prolongationSeconds},
                                 {"deform", info.seconds}}}};
+  addTransferList(outcome.details, "coarse_device_transfers", info.coarseTransfers);
+  addTransferList(outcome.details, "projection_device_transfers", info.projectionTransfers);
   return outcome;
 }
 
