@@ -86,7 +86,7 @@ void fineConstraints(const PositionalConstraints& constraints, const Positions& 
 
 /// Direct single-level deformation of the finest mesh (the rule chose it).
 void deformFinest(compute::Backend& backend, const PolygonMesh& mesh, const PositionalConstraints& constraints,
-                  const MultiresSettings& settings, MultiresResult& result) {
+                  const MultiresSettings& settings, const MultiresCallback& callback, MultiresResult& result) {
   DeformationSettings direct;
   direct.energy = settings.energy;
   direct.maxIterations = settings.maxCoarseIterations;
@@ -96,13 +96,22 @@ void deformFinest(compute::Backend& backend, const PolygonMesh& mesh, const Posi
   direct.global = settings.global;
   direct.global.smoothness = 0.0;
   const auto start = SteadyClock::now();
-  const DeformationResult deformed = deform(backend, mesh, constraints, direct);
+  int ideal = 0;
+  int projection = 0;
+  const auto forward = [&](const DeformationIteration& it) {
+    if (!callback) return;
+    const bool coarse = it.phase == DeformationPhase::Ideal;
+    callback({coarse ? MultiresPhase::Coarse : MultiresPhase::Projection, coarse ? ++ideal : ++projection,
+              coarse ? it.epsilon : 0.0, coarse ? it.displacement : 0.0, it.maxPlanarity, it.transfers});
+  };
+  const DeformationResult deformed = deform(backend, mesh, constraints, direct, forward);
   if (deformed.info.status == DeformationStatus::NumericalFailure) throwNumerical("multires: " + deformed.info.message);
   result.positions = deformed.mesh.vertices;
   result.info.coarseIterations = deformed.info.iterations;
   for (const auto& it : deformed.info.history) {
     result.info.coarseEpsilons.push_back(it.epsilon);
     result.info.coarseDisplacements.push_back(it.displacement);
+    result.info.coarseTransfers.push_back(it.transfers);
   }
   result.info.coarseSeconds = secondsSince(start);
   if (deformed.info.status != DeformationStatus::Converged) result.info.status = MultiresStatus::MaxIterationsReached;
@@ -120,7 +129,7 @@ const char* toString(MultiresStatus status) {
 
 MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierarchy& hierarchy,
                               const std::vector<Positions>& positions, const PositionalConstraints& constraints,
-                              const MultiresSettings& settings) {
+                              const MultiresSettings& settings, const MultiresCallback& callback) {
   checkInput(hierarchy, positions, settings);
   const auto start = SteadyClock::now();
   const int finest = hierarchy.finestLevel();
@@ -138,7 +147,7 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
   info.fineFaces = fineMesh.faceCount();
 
   if (level == finest) {
-    deformFinest(backend, fineMesh, constraints, settings, result);
+    deformFinest(backend, fineMesh, constraints, settings, callback, result);
   } else {
     // Coarse deformation (§6.1 on M_k with the coarsened constraints of §6.2).
     const auto coarseStart = SteadyClock::now();
@@ -166,6 +175,10 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
       info.coarseDisplacements.push_back(next.displacement);  // normalized units: over the diagonal's scale
       info.coarseTransfers.push_back(compute::transfersSince(transfersBefore, backend.transfers()));
       ++info.coarseIterations;
+      if (callback) {
+        callback({MultiresPhase::Coarse, info.coarseIterations, step.epsilon, next.displacement, next.maxPlanarity,
+                  info.coarseTransfers.back()});
+      }
       coarseCurrent = std::move(next.positions);
       coarseColumns = std::move(columns);
       converged = next.displacement < settings.tolerance;
@@ -215,6 +228,10 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
         planarity = next.maxPlanarity;
         info.projectionTransfers.push_back(compute::transfersSince(transfersBefore, backend.transfers()));
         ++info.projectionIterations;
+        if (callback) {
+          callback({MultiresPhase::Projection, info.projectionIterations, 0.0, 0.0, planarity,
+                    info.projectionTransfers.back()});
+        }
       }
       result.positions = fineSpace.normalization().toWorld(Positions(current.values()));
     }

@@ -18,6 +18,7 @@
 // vertices are held where they are on their own level, and handles act on the ambient
 // space of the coarse maps in either case. When the rule picks the finest level, the
 // single-level deformation (Deformation.h) runs on M_n directly.
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -84,6 +85,25 @@ struct MultiresInfo {
   double seconds = 0.0;
 };
 
+enum class MultiresPhase {
+  Coarse,      ///< A local/global iteration on the deformation level.
+  Projection,  ///< A projection iteration of the fine result (§5), after the prolongation.
+};
+
+/// One iteration, for progress output and monitoring.
+struct MultiresIteration {
+  MultiresPhase phase = MultiresPhase::Coarse;
+  int iteration = 0;           ///< 1-based, within its phase.
+  double epsilon = 0.0;        ///< Coarse: the global step's final eps (0 for a projection iteration).
+  double displacement = 0.0;   ///< Coarse: max vertex move / bounding-box diagonal (0 for a projection iteration).
+  double maxPlanarity = 0.0;   ///< Percent, of the level the iteration ran on, after it.
+  /// Host <-> device copies of the iteration (compute::Backend::transfers; none on the CPU).
+  std::optional<compute::DeviceTransfers> transfers;
+};
+
+/// Called after every iteration; may be empty.
+using MultiresCallback = std::function<void(const MultiresIteration&)>;
+
 struct MultiresResult {
   Positions positions;  ///< #V_n x 3, the deformed finest mesh.
   MultiresInfo info;
@@ -99,6 +119,6 @@ struct MultiresResult {
 /// global step fails.
 MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierarchy& hierarchy,
                               const std::vector<Positions>& positions, const PositionalConstraints& constraints,
-                              const MultiresSettings& settings = {});
+                              const MultiresSettings& settings = {}, const MultiresCallback& callback = {});
 
 }  // namespace plano::projective

@@ -224,6 +224,51 @@ TEST_F(WholeAlgorithmAgreement, MultiresProjectionIterationsGiveTheCpuMeshWithTh
   EXPECT_LT(relativeDifference(result.positions, reference.positions), kAgreement);
 }
 
+TEST_F(WholeAlgorithmAgreement, ASteadyMultiresCoarseIterationCopiesNoMeshSizedArray) {
+  // The coarse loop keeps its normalized positions, ideal maps and solution on the device;
+  // the last solution's maps come back once, for the prolongation. A 6 x 6 base (49
+  // vertices: its positions, 1176 B, are well above a check's 288 B) subdivided once.
+  compute::CpuBackend cpu;
+  projective::PqSubdivisionSettings subdivision;
+  subdivision.levels = 1;
+  subdivision.planarityTolerance = 0.5;
+  const projective::PqSubdivisionResult hierarchy =
+      projective::subdividePlanarQuads(cpu, generate::translationalSurface(6, 6), subdivision);
+  const Positions& finest = hierarchy.positions.back();
+  PositionalConstraints constraints;
+  const double yMin = finest.col(1).minCoeff();
+  for (Index v = 0; v < finest.rows(); ++v) {
+    if (finest(v, 1) < yMin + 1e-9) constraints.fixed.push_back(v);
+  }
+  Index corner = 0;
+  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
+  constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.3)});
+  projective::MultiresSettings settings;
+  settings.level = 0;
+  settings.maxCoarseIterations = 3;
+
+  std::vector<vk::TransferCounts> steady;
+  const projective::MultiresResult result = projective::multiresDeform(
+      backend(), hierarchy.hierarchy, hierarchy.positions, constraints, settings,
+      [&](const projective::MultiresIteration& it) {
+        if (it.phase == projective::MultiresPhase::Coarse && it.iteration > 1) steady.push_back(context().transfers());
+        context().resetLargestTransfers();
+      });
+  const projective::MultiresResult reference =
+      projective::multiresDeform(cpu, hierarchy.hierarchy, hierarchy.positions, constraints, settings);
+  ASSERT_EQ(result.info.coarseIterations, 3) << "the case must run every coarse iteration";
+  EXPECT_EQ(reference.info.coarseIterations, result.info.coarseIterations);
+  EXPECT_LT(relativeDifference(result.positions, reference.positions), kAgreement);
+  ASSERT_EQ(steady.size(), 2u);
+  expectNoMeshSizedCopies(steady, PolygonMesh{hierarchy.positions.front(), hierarchy.hierarchy.faces(0)});
+  // Per iteration, the report's counts: a few kB of scalars whatever the mesh.
+  ASSERT_EQ(result.info.coarseTransfers.size(), 3u);
+  for (std::size_t i = 1; i < result.info.coarseTransfers.size(); ++i) {
+    ASSERT_TRUE(result.info.coarseTransfers[i].has_value());
+    EXPECT_GT(result.info.coarseTransfers[i]->copies, 0u);
+  }
+}
+
 TEST_F(WholeAlgorithmAgreement, SubspaceDeformationGivesTheCpuMeshWithTheSameIterations) {
   // A vertical-space dome, its first ring fixed and one vertex pulled up: 28 free
   // dimensions, ~25 iterations to the default tolerance (more than one device block).

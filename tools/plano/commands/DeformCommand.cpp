@@ -189,8 +189,19 @@ DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& glo
   settings.maxCoarseIterations = options.maxIterations;
   settings.tolerance = options.tolerance;
   settings.planarityTolerance = options.planarityTolerance;
-  const projective::MultiresResult result =
-      projective::multiresDeform(backend, subdivision.hierarchy, subdivision.positions, constraints, settings);
+  const auto callback = [&](const projective::MultiresIteration& it) {
+    std::ostringstream line;
+    line << std::setprecision(3) << "multires ";
+    if (it.phase == projective::MultiresPhase::Coarse) {
+      line << "iteration " << it.iteration << ": displacement " << it.displacement << ", eps " << it.epsilon;
+    } else {
+      line << "projection " << it.iteration << " of the fine mesh";
+    }
+    line << ", max planarity " << it.maxPlanarity << "%";
+    progress(global, line.str());
+  };
+  const projective::MultiresResult result = projective::multiresDeform(backend, subdivision.hierarchy,
+                                                                       subdivision.positions, constraints, settings, callback);
   const projective::MultiresInfo& info = result.info;
   progress(global, "multires: deformed on level " + std::to_string(info.level) + " (" +
                        std::to_string(info.coarseFaces) + " faces) in " + std::to_string(info.coarseIterations) +
