@@ -99,10 +99,8 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
       throwIfCancelled("deformation (projection)");
       transfersBefore = backend_.transfers();
       compute::DeviceProjectiveFits fits;
-      backend_.fitProjectiveMapsOnDevice(space_.faces(), space_.basePositions(), current,
-                                         GlobalStep::kMinimumReciprocalScale, fits);
       compute::DeviceMatrix columns;
-      const GlobalStepInfo step = global_.solve(fits, targets, columns);
+      const GlobalStepInfo step = global_.solveProjectiveFitsAt(current, targets, fits, columns);
       planar = advance(DeformationPhase::Projection, step, columns, fits.reciprocalScales).maxPlanarity <=
                planarityBound;
     }

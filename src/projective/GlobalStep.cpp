@@ -151,6 +151,13 @@ GlobalStepInfo GlobalStep::solve(const compute::DeviceProjectiveFits& fits, cons
   return info;
 }
 
+GlobalStepInfo GlobalStep::solveProjectiveFitsAt(const compute::DeviceMatrix& current, const Positions& positions,
+                                                 compute::DeviceProjectiveFits& fits,
+                                                 compute::DeviceMatrix& resultColumns) {
+  backend_.fitProjectiveMapsOnDevice(space_.faces(), space_.basePositions(), current, kMinimumReciprocalScale, fits);
+  return solve(fits, positions, resultColumns);
+}
+
 GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
                                        FaceMaps& result) {
   compute::DeviceMatrix columns;

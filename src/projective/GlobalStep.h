@@ -129,6 +129,11 @@ class GlobalStep {
   /// are the fits', unchanged; its corner weights the fits' scales). Throws as solve().
   GlobalStepInfo solve(const compute::DeviceProjectiveFits& fits, const Positions& positions,
                        compute::DeviceMatrix& resultColumns);
+  /// A projection step (§5) where the backend keeps its arrays: the projective fits of the
+  /// faces at `current` (#V x 3 normalized positions), then solve(fits, ...). `fits` out:
+  /// the fits, whose reciprocal scales are the result's corner weights. Throws as solve().
+  GlobalStepInfo solveProjectiveFitsAt(const compute::DeviceMatrix& current, const Positions& positions,
+                                       compute::DeviceProjectiveFits& fits, compute::DeviceMatrix& resultColumns);
 
   /// Below this |shat| a corner is mapped (numerically) to the plane at infinity: no map
   /// sends a vertex there.

@@ -217,10 +217,8 @@ MultiresResult multiresDeform(compute::Backend& backend, const SubdivisionHierar
         throwIfCancelled("multi-resolution deformation (projection)");
         const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
         compute::DeviceProjectiveFits fits;
-        backend.fitProjectiveMapsOnDevice(fineSpace.faces(), fineSpace.basePositions(), current,
-                                          GlobalStep::kMinimumReciprocalScale, fits);
         compute::DeviceMatrix columns;
-        fineStep.solve(fits, targets, columns);
+        fineStep.solveProjectiveFitsAt(current, targets, fits, columns);
         compute::MapPositions next;
         backend.mapPositions(fineSpace.faces(), fineSpace.basePositions(), corners, columns, fits.reciprocalScales,
                              current, next);

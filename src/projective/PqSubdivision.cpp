@@ -45,10 +45,8 @@ Positions planarizeLevel(compute::Backend& backend, const PolygonMesh& refined, 
     throwIfCancelled("subdivision");
     const std::optional<compute::DeviceTransfers> transfersBefore = backend.transfers();
     compute::DeviceProjectiveFits fits;
-    backend.fitProjectiveMapsOnDevice(space.faces(), space.basePositions(), current,
-                                      GlobalStep::kMinimumReciprocalScale, fits);
     compute::DeviceMatrix columns;
-    const GlobalStepInfo step = global.solve(fits, Positions(), columns);
+    const GlobalStepInfo step = global.solveProjectiveFitsAt(current, Positions(), fits, columns);
     compute::MapPositions next;
     backend.mapPositions(space.faces(), space.basePositions(), corners, columns, fits.reciprocalScales, current, next);
     current = std::move(next.positions);

@@ -49,6 +49,30 @@ void expectNoMeshSizedCopies(const std::vector<vk::TransferCounts>& iterations, 
   }
 }
 
+/// An n x n translational surface subdivided `levels` times on the CPU, its finest row
+/// y = 0 fixed and its far corner lifted by `lift`.
+struct MultiresCase {
+  projective::PqSubdivisionResult hierarchy;
+  PositionalConstraints constraints;
+};
+
+MultiresCase liftedCornerHierarchy(Index n, int levels, double lift) {
+  compute::CpuBackend cpu;
+  projective::PqSubdivisionSettings subdivision;
+  subdivision.levels = levels;
+  subdivision.planarityTolerance = 0.5;
+  MultiresCase c{projective::subdividePlanarQuads(cpu, generate::translationalSurface(n, n), subdivision), {}};
+  const Positions& finest = c.hierarchy.positions.back();
+  const double yMin = finest.col(1).minCoeff();
+  for (Index v = 0; v < finest.rows(); ++v) {
+    if (finest(v, 1) < yMin + 1e-9) c.constraints.fixed.push_back(v);
+  }
+  Index corner = 0;
+  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
+  c.constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, lift)});
+  return c;
+}
+
 using WholeAlgorithmAgreement = VulkanTest;
 
 TEST_F(WholeAlgorithmAgreement, SingleLevelDeformationGivesTheCpuMeshWithTheSameIterations) {
@@ -160,20 +184,7 @@ TEST_F(WholeAlgorithmAgreement, MultiresDeformationGivesTheCpuMeshWithTheSameIte
   // A 3 x 3 translational surface subdivided twice (144 quads), its row y = 0 fixed and
   // a far corner lifted; the deformation runs on a coarse level and is prolongated.
   compute::CpuBackend cpu;
-  projective::PqSubdivisionSettings subdivision;
-  subdivision.levels = 2;
-  subdivision.planarityTolerance = 0.5;
-  const projective::PqSubdivisionResult hierarchy =
-      projective::subdividePlanarQuads(cpu, generate::translationalSurface(3, 3), subdivision);
-  const Positions& finest = hierarchy.positions.back();
-  PositionalConstraints constraints;
-  const double yMin = finest.col(1).minCoeff();
-  for (Index v = 0; v < finest.rows(); ++v) {
-    if (finest(v, 1) < yMin + 1e-9) constraints.fixed.push_back(v);
-  }
-  Index corner = 0;
-  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
-  constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.2)});
+  const auto [hierarchy, constraints] = liftedCornerHierarchy(3, 2, 0.2);
 
   const projective::MultiresResult reference =
       projective::multiresDeform(cpu, hierarchy.hierarchy, hierarchy.positions, constraints);
@@ -193,20 +204,7 @@ TEST_F(WholeAlgorithmAgreement, MultiresProjectionIterationsGiveTheCpuMeshWithTh
   // constraints) run on the fine level, on the device with their fits, scales, solution
   // and positions kept there.
   compute::CpuBackend cpu;
-  projective::PqSubdivisionSettings subdivision;
-  subdivision.levels = 1;
-  subdivision.planarityTolerance = 0.5;
-  const projective::PqSubdivisionResult hierarchy =
-      projective::subdividePlanarQuads(cpu, generate::translationalSurface(3, 3), subdivision);
-  const Positions& finest = hierarchy.positions.back();
-  PositionalConstraints constraints;
-  const double yMin = finest.col(1).minCoeff();
-  for (Index v = 0; v < finest.rows(); ++v) {
-    if (finest(v, 1) < yMin + 1e-9) constraints.fixed.push_back(v);
-  }
-  Index corner = 0;
-  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
-  constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.3)});
+  const auto [hierarchy, constraints] = liftedCornerHierarchy(3, 1, 0.3);
   projective::MultiresSettings settings;
   settings.level = 0;
   settings.global.epsilonStart = projective::EpsilonStart::Relaxed;
@@ -229,20 +227,7 @@ TEST_F(WholeAlgorithmAgreement, ASteadyMultiresCoarseIterationCopiesNoMeshSizedA
   // the last solution's maps come back once, for the prolongation. A 6 x 6 base (49
   // vertices: its positions, 1176 B, are well above a check's 288 B) subdivided once.
   compute::CpuBackend cpu;
-  projective::PqSubdivisionSettings subdivision;
-  subdivision.levels = 1;
-  subdivision.planarityTolerance = 0.5;
-  const projective::PqSubdivisionResult hierarchy =
-      projective::subdividePlanarQuads(cpu, generate::translationalSurface(6, 6), subdivision);
-  const Positions& finest = hierarchy.positions.back();
-  PositionalConstraints constraints;
-  const double yMin = finest.col(1).minCoeff();
-  for (Index v = 0; v < finest.rows(); ++v) {
-    if (finest(v, 1) < yMin + 1e-9) constraints.fixed.push_back(v);
-  }
-  Index corner = 0;
-  (finest.col(0) + finest.col(1)).maxCoeff(&corner);
-  constraints.handles.push_back({corner, finest.row(corner).transpose() + Eigen::Vector3d(0.0, 0.0, 0.3)});
+  const auto [hierarchy, constraints] = liftedCornerHierarchy(6, 1, 0.3);
   projective::MultiresSettings settings;
   settings.level = 0;
   settings.maxCoarseIterations = 3;
