@@ -18,7 +18,14 @@ nlohmann::json readJson(const std::filesystem::path& path) {
   return nlohmann::json::parse(in);
 }
 
-std::string quoted(const std::filesystem::path& p) { return "\"" + p.string() + "\""; }
+// Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) about the
+// concatenation of literals around a temporary here.
+std::string quoted(const std::filesystem::path& p) {
+  std::string q(1, '"');
+  q += p.string();
+  q += '"';
+  return q;
+}
 
 TEST(SubspaceCommand, ReportsDimensionLowerBoundAndFaceTypes) {
   TempDir dir;
@@ -35,6 +42,22 @@ TEST(SubspaceCommand, ReportsDimensionLowerBoundAndFaceTypes) {
   EXPECT_EQ(j["non_maximal_faces"].size(), 6u);
   EXPECT_TRUE(j.contains("planarity"));
   EXPECT_TRUE(j.contains("seconds"));
+}
+
+TEST(SubspaceCommand, AskedForVulkanItWarnsThatItComputesOnTheCpuAndReportsCpu) {
+  // The linear-space commands have no device kernels: the result is the CPU's, and the
+  // user is told so, even with -q (a warning, not progress), instead of reading CPU
+  // timings as the device's.
+  TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const auto asked = runTool("-q --backend vulkan subspace " + quoted(dir / "cube.obj") + " --space parallel --report " +
+                             quoted(dir / "r.json"));
+  ASSERT_EQ(asked.exitCode, 0) << asked.err;
+  EXPECT_NE(asked.err.find("warning: plano subspace computes on the CPU"), std::string::npos) << asked.err;
+  EXPECT_EQ(readJson(dir / "r.json")["backend"], "cpu");
+  const auto plain = runTool("-q subspace " + quoted(dir / "cube.obj") + " --space parallel");
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  EXPECT_EQ(plain.err.find("warning"), std::string::npos) << plain.err;
 }
 
 TEST(SubspaceCommand, MixedSpaceReadsTheFacesFileAndRejectsAShortOne) {

@@ -40,6 +40,12 @@ struct CommandRegistration {
 /// Create the backend the user asked for, printing a fallback warning on stderr.
 std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options);
 
+/// For a command that computes on the CPU whatever the backend (the linear-space commands:
+/// their factorizations, eigenproblems and embeddings have no device kernels): a warning on
+/// stderr, even with --quiet, when --backend vulkan asked for the device, so that nobody
+/// takes its results or timings for the device's. Returns the backend name for the report.
+std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command);
+
 /// Progress line on stderr unless --quiet.
 void progress(const GlobalOptions& options, const std::string& message);
 

@@ -21,6 +21,16 @@ std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options) {
   return backend;
 }
 
+std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command) {
+  if (options.backend == "vulkan") {
+    std::cerr << "warning: plano " << command
+              << " computes on the CPU: the linear-space factorizations have no Vulkan kernels (--backend vulkan "
+                 "applies to subdivide, planarize, prescribe, interpolate and deform)"
+              << std::endl;
+  }
+  return "cpu";
+}
+
 void progress(const GlobalOptions& options, const std::string& message) {
   if (!options.quiet) std::cerr << message << std::endl;
 }

@@ -43,6 +43,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
+    const std::string backend = warnComputesOnCpu(global, "dual");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);
@@ -75,7 +76,7 @@ RunFunction setup(CLI::App& app) {
                 << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    j = baseReport("dual", "cpu", o->primal.empty() ? dual : mesh, stats, seconds);
+    j = baseReport("dual", backend, o->primal.empty() ? dual : mesh, stats, seconds);
     j["dual_vertices"] = dual.vertexCount();
     j["dual_faces"] = dual.faceCount();
     j["dual_max_planarity"] = planarityStats(dual).max;

@@ -39,6 +39,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
+    const std::string backend = warnComputesOnCpu(global, "embed");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh topology = readMesh(o->input);
     TutteInfo tutte;
@@ -56,7 +57,7 @@ RunFunction setup(CLI::App& app) {
     }
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j = baseReport("embed", "cpu", out, stats, seconds);
+    nlohmann::json j = baseReport("embed", backend, out, stats, seconds);
     j["boundary_vertices"] = tutte.boundaryVertices;
     j["flipped_faces"] = tutte.flippedFaces;
     j["lift"] = o->lift;

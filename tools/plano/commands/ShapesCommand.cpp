@@ -54,7 +54,8 @@ RunFunction setup(CLI::App& app) {
   app.add_option("-o,--output", o->output, "Output mesh")->required();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
-  return [o](const GlobalOptions&) {
+  return [o](const GlobalOptions& global) {
+    const std::string backend = warnComputesOnCpu(global, "shapes");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     if (o->vertex < 0 || o->vertex >= mesh.vertexCount()) {
@@ -98,7 +99,7 @@ RunFunction setup(CLI::App& app) {
     PolygonMesh out = mesh;
     out.vertices = base + (peak > 0.0 ? o->amplitude * boundingBoxDiagonal(mesh.vertices) / peak : 0.0) * shape;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j = baseReport("shapes", "cpu", out, planarityStats(out), seconds);
+    nlohmann::json j = baseReport("shapes", backend, out, planarityStats(out), seconds);
     j["space"] = o->space;
     j["kind"] = o->kind;
     j["vertex"] = o->vertex;

@@ -45,6 +45,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--rank-tolerance", o->rankTolerance, "Relative rank tolerance of B")->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   return [o](const GlobalOptions& global) {
+    const std::string backend = warnComputesOnCpu(global, "subspace");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     LinearSpaceSettings settings;
@@ -62,7 +63,7 @@ RunFunction setup(CLI::App& app) {
     const SubspaceTopology topology = computeTopology(mesh.faces, mesh.vertexCount());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-    nlohmann::json j = baseReport("subspace", "cpu", mesh, planarityStats(mesh), seconds);
+    nlohmann::json j = baseReport("subspace", backend, mesh, planarityStats(mesh), seconds);
     j["status"] = "ok";  // failures (rank, basis) end in Error(Numerical) and main's failure report
     j["space"] = o->space;
     j["dimension"] = space.dof.dimension;
