@@ -98,53 +98,6 @@ MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpa
   P_ = smoothnessMatrix(space_, settings_.smoothness);
 }
 
-GlobalStepInfo MultiresCoarseStep::solve(const std::vector<Eigen::Matrix4d>& targets, FaceMaps& result) {
-  const Index faceCount = space_.faceCount();
-  if (static_cast<Index>(targets.size()) != faceCount) {
-    throwUsage("coarse global step: " + std::to_string(targets.size()) + " target maps for " +
-               std::to_string(faceCount) + " faces");
-  }
-  for (Index f = 0; f < faceCount; ++f) {
-    if (!targets[f].allFinite()) {
-      throwNumerical("coarse global step: the target map of face " + std::to_string(f) + " is not finite");
-    }
-  }
-  const std::vector<double> shat = space_.inducedReciprocalScales(targets);
-  Index nonPositive = 0;
-  for (Index c = 0; c < space_.cornerCount(); ++c) {
-    if (shat[c] <= 0.0) ++nonPositive;
-    if (!(std::abs(shat[c]) > GlobalStep::kMinimumReciprocalScale)) {
-      throwNumerical("coarse global step: the target map of face " + std::to_string(space_.cornerFace(c)) +
-                     " sends vertex " + std::to_string(space_.faces().indices()[c]) + " to infinity");
-    }
-  }
-  // Scales: the corners' reciprocal scale factors, then one per handle (its point's).
-  std::vector<double> scales = shat;
-  scales.reserve(shat.size() + handles_.size());
-  for (const MapPointConstraint& h : handles_) {
-    const Eigen::RowVector4d p(h.point.x(), h.point.y(), h.point.z(), 1.0);
-    const double scale = p.dot(targets[h.face].col(3).transpose());
-    if (!(std::abs(scale) > GlobalStep::kMinimumReciprocalScale)) {
-      throwNumerical("coarse global step: the target map of face " + std::to_string(h.face) + " sends handle " +
-                     std::to_string(h.handle) + " to infinity");
-    }
-    scales.push_back(scale);
-  }
-  Eigen::MatrixXd T(4 * faceCount, 3);
-  for (Index f = 0; f < faceCount; ++f) T.middleRows<4>(4 * f) = targets[f].leftCols<3>();
-  compute::DeviceMatrix columns;
-  GlobalStepInfo info = project(compute::DeviceMatrix(std::move(T)), scales, columns);
-  info.nonPositiveScales = nonPositive;
-  const Eigen::MatrixXd& x = columns.values();
-  result.maps.resize(faceCount);
-  for (Index f = 0; f < faceCount; ++f) {
-    result.maps[f].leftCols<3>() = x.middleRows<4>(4 * f);
-    result.maps[f].col(3) = targets[f].col(3);
-  }
-  result.reciprocalScales = shat;
-  return info;
-}
-
 GlobalStepInfo MultiresCoarseStep::solveAffine(const compute::DeviceMatrix& linearColumns,
                                                compute::DeviceMatrix& resultColumns) {
   const Index faceCount = space_.faceCount();
@@ -154,11 +107,6 @@ GlobalStepInfo MultiresCoarseStep::solveAffine(const compute::DeviceMatrix& line
   }
   // Fourth columns (0, 0, 0, 1): every corner's and every handle point's scale is 1.
   const std::vector<double> scales(space_.cornerCount() + handles_.size(), 1.0);
-  return project(linearColumns, scales, resultColumns);
-}
-
-GlobalStepInfo MultiresCoarseStep::project(const compute::DeviceMatrix& T, std::span<const double> scales,
-                                           compute::DeviceMatrix& x) {
   const auto m = static_cast<Eigen::Index>(rows_.size());
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, 3);
   std::vector<char> relaxed(m, 0);
@@ -181,7 +129,7 @@ GlobalStepInfo MultiresCoarseStep::project(const compute::DeviceMatrix& T, std::
   BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
   GlobalStepInfo info;
   compute::RelaxedBounds bounds{std::move(d), std::move(relaxed), 0.0};
-  solveEpsilonSchedule(qp, T, bounds, settings_, "coarse global step", info, x);
+  solveEpsilonSchedule(qp, linearColumns, bounds, settings_, "coarse global step", info, resultColumns);
   return info;
 }
 

@@ -6,12 +6,11 @@
 //  - handles attached to the maps of coarse faces: (p, 1) A_f proportional to (q, 1) for a
 //    point p of the ambient space (the handle's fine position) and its target q.
 // GlobalStep (GlobalStep.h) constrains mesh vertices only; this step adds the ambient
-// point rows and otherwise follows the same structure: scale factors induced by the
-// targets and held fixed (for a point, shat = (p, 1) T_f[:, 3]), fourth columns taken from
-// the targets, three QPs for columns 0..2 sharing one matrix (BoxQp.h), the paper's ε
-// schedule on the compatibility rows only.
+// point rows and otherwise follows the same structure for the affine targets of the coarse
+// loop (every scale factor 1, for a point too: shat = (p, 1) T_f[:, 3] = 1): three QPs for
+// columns 0..2 sharing one matrix (BoxQp.h), the paper's ε schedule (solveEpsilonSchedule)
+// on the compatibility rows only.
 #include <memory>
-#include <span>
 #include <vector>
 
 #include "compute/Backend.h"
@@ -33,22 +32,16 @@ class MultiresCoarseStep {
   MultiresCoarseStep(compute::Backend& backend, const ShapeSpace& space, std::vector<Index> fixed,
                      std::vector<MapPointConstraint> handles, const GlobalStepSettings& settings = {});
 
-  /// Project the target maps (normalized coordinates, #F) onto the compatible maps that
-  /// satisfy the constraints. result: out, the maps and reciprocal scales. Throws
-  /// Error(Numerical) as GlobalStep::solve does.
-  GlobalStepInfo solve(const std::vector<Eigen::Matrix4d>& targets, FaceMaps& result);
-  /// The same for affine targets (ideal maps: fourth columns (0, 0, 0, 1)) by their first
-  /// three columns, 4 #F x 3, which may stay on the device that computed them; the result's
-  /// first three columns are left where the QP solved for them (GlobalStep::solveAffine's
-  /// contract: readable while this object lives and until its next solve). Throws as
-  /// solve(), and Error(Usage) for targets of the wrong size.
+  /// Project affine targets (the ideal maps of the rigid/similar local step: fourth columns
+  /// (0, 0, 0, 1), normalized coordinates), given by their first three columns, 4 #F x 3,
+  /// which may stay on the device that computed them, onto the compatible maps that satisfy
+  /// the constraints. The result's first three columns are left where the QP solved for
+  /// them (GlobalStep::solveAffine's contract: readable while this object lives and until
+  /// its next solve). Throws Error(Numerical) as GlobalStep::solve does, and Error(Usage)
+  /// for targets of the wrong size.
   GlobalStepInfo solveAffine(const compute::DeviceMatrix& linearColumns, compute::DeviceMatrix& resultColumns);
 
  private:
-  /// The solves after their target checks: T (4 #F x 3) the targets' first three columns,
-  /// scales the corners' reciprocal scales then the handle points'.
-  GlobalStepInfo project(const compute::DeviceMatrix& T, std::span<const double> scales, compute::DeviceMatrix& x);
-
   enum class RowKind { Compatibility, Fixed, MapPoint };
   struct Row {
     RowKind kind;

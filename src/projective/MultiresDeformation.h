@@ -72,7 +72,9 @@ struct MultiresInfo {
   std::vector<double> coarseEpsilons;  ///< Per coarse global step.
   std::vector<double> coarseDisplacements;
   /// Per coarse iteration and per projection iteration: the copies between host and device
-  /// (Backend::transfers; nullopt on a backend that does not count them).
+  /// (Backend::transfers; nullopt on a backend that does not count them). When the finest
+  /// level is the deformation level, coarseTransfers, like coarseEpsilons, has every
+  /// iteration of the single-level deformation, its projection phase included.
   std::vector<std::optional<compute::DeviceTransfers>> coarseTransfers;
   std::vector<std::optional<compute::DeviceTransfers>> projectionTransfers;
   GlobalStepInfo fineStep;            ///< The prolongation's global step.
