@@ -117,6 +117,36 @@ void BM_DeformationPrecompute(benchmark::State& state, SpaceKind kind) {
   state.counters["faces"] = mesh.faceCount();
 }
 
+/// The reduced operator N^T (L (x) I_k) N (Backend::reducedOperator): the d x d matrix
+/// behind the eigenshapes, the subspace deformation's global matrix and the fundamental
+/// shapes, whose 2 k #V d^2 multiply-adds dominate them once d reaches the hundreds. Per
+/// backend on the standard mesh sizes, L the grid's uniform Laplacian and N a random
+/// #V x 256 basis (k = 1: a separable space's scalar basis, dimension 768; a basis's values
+/// do not change the work, and a real basis at 1M faces would take minutes to compute).
+void BM_ReducedOperator(benchmark::State& state, compute::BackendChoice choice) {
+  compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  const plano::bench::MemoryCounters memory(state, backend);
+  constexpr Index columns = 256;
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
+  const Eigen::MatrixXd N = Eigen::MatrixXd::Random(mesh.vertexCount(), columns);
+  for (auto _ : state) {
+    const Eigen::MatrixXd R = backend->reducedOperator(L, N, 1);
+    benchmark::DoNotOptimize(R.data());
+  }
+  const double flops = 2.0 * static_cast<double>(N.rows()) * columns * columns + 2.0 * L.nonZeros() * columns;
+  state.counters["faces"] = static_cast<double>(mesh.faceCount());
+  state.counters["columns"] = columns;
+  state.counters["gflop_per_s"] = benchmark::Counter(flops * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  plano::bench::setThroughput(state, static_cast<double>(mesh.faceCount()));
+}
+
+BENCHMARK_CAPTURE(BM_ReducedOperator, cpu, compute::BackendChoice::Cpu)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_ReducedOperator, cpu, compute::BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_ReducedOperator, vulkan, compute::BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_ReducedOperator, vulkan, compute::BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
+
 BENCHMARK_CAPTURE(BM_ConstraintMatrix, affine, SpaceKind::Affine)
     ->Arg(1024)->Arg(10000)->Arg(100489)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ConstraintMatrix, parallel, SpaceKind::Parallel)

@@ -32,6 +32,7 @@ inline void warmUp(compute::Backend& backend) {
   identity.makeCompressed();
   Eigen::MatrixXd X = Eigen::MatrixXd::Zero(8, 3);
   backend.createSpdSolver(identity, {})->solve(cube.vertices, X);
+  (void)backend.reducedOperator(identity, Eigen::MatrixXd::Ones(8, 2), 1);
 }
 
 /// The process-wide backend of a kind (warmed up), or null with the reason in *error.

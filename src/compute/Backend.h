@@ -251,6 +251,12 @@ class Backend {
   virtual std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
       const std::function<ReducedArapProblem()>& problem);
 
+  /// The reduced operator N^T (S (x) I_k) N of a linear space's basis (compute/
+  /// ReducedOperator.h: N has k #V rows, row k v + c coordinate c of vertex v; S is
+  /// #V x #V; the result d x d). A device backend uploads N and S and brings back the d x d
+  /// result only. Throws Error(Usage) for mismatched sizes. The default is the CPU reference.
+  virtual Eigen::MatrixXd reducedOperator(const SparseMatrix& S, const Eigen::MatrixXd& N, int coordinates);
+
   /// Host <-> device copies since this backend was created; nullopt for a backend whose
   /// data never leaves the host (the CPU).
   virtual std::optional<DeviceTransfers> transfers() const { return std::nullopt; }

@@ -5,6 +5,7 @@
 #include <Spectra/SymEigsSolver.h>
 #include <string>
 
+#include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
 
 namespace plano::subspace {
@@ -45,7 +46,7 @@ Eigenpairs smallestEigenpairs(const Eigen::MatrixXd& R, Index count, const Eigen
 
 }  // namespace
 
-Eigenshapes computeEigenshapes(const SubspaceBasis& N, const compute::SparseMatrix& L,
+Eigenshapes computeEigenshapes(compute::Backend& backend, const SubspaceBasis& N, const compute::SparseMatrix& L,
                                const EigenshapeSettings& settings, EigenshapeInfo* info) {
   EigenshapeInfo local;
   Eigenshapes shapes;
@@ -56,10 +57,11 @@ Eigenshapes computeEigenshapes(const SubspaceBasis& N, const compute::SparseMatr
     if (info) *info = local;
     return shapes;
   }
+  // For a separable basis N^T (L (x) I3) N = (N1^T L N1) (x) I3: the compact operator is
+  // the scalar problem, whose eigenpairs repeat per coordinate.
+  const Eigen::MatrixXd R = N.compactReducedOperator(backend, L);
   if (N.separable()) {
-    // N^T (L (x) I3) N = (N1^T L N1) (x) I3: solve the scalar problem, repeat per coordinate.
-    const Eigen::MatrixXd R1 = N.columns().transpose() * (L * N.columns());
-    const Eigenpairs pairs = smallestEigenpairs(0.5 * (R1 + R1.transpose()), (count + 2) / 3, settings, local);
+    const Eigenpairs pairs = smallestEigenpairs(0.5 * (R + R.transpose()), (count + 2) / 3, settings, local);
     shapes.coefficients = Eigen::MatrixXd::Zero(d, count);
     shapes.frequencies.resize(count);
     for (Index k = 0; k < count; ++k) {
@@ -68,13 +70,18 @@ Eigenshapes computeEigenshapes(const SubspaceBasis& N, const compute::SparseMatr
       for (Eigen::Index a = 0; a < pairs.vectors.rows(); ++a) shapes.coefficients(3 * a + c, k) = pairs.vectors(a, j);
     }
   } else {
-    const Eigen::MatrixXd R = N.reducedOperator(L);
     const Eigenpairs pairs = smallestEigenpairs(0.5 * (R + R.transpose()), count, settings, local);
     shapes.coefficients = pairs.vectors;
     shapes.frequencies = pairs.values;
   }
   if (info) *info = local;
   return shapes;
+}
+
+Eigenshapes computeEigenshapes(const SubspaceBasis& N, const compute::SparseMatrix& L,
+                               const EigenshapeSettings& settings, EigenshapeInfo* info) {
+  compute::CpuBackend cpu;
+  return computeEigenshapes(cpu, N, L, settings, info);
 }
 
 Positions bandPass(const SubspaceBasis& N, const Eigenshapes& shapes, const Positions& base, Index lo, Index hi,

@@ -34,6 +34,11 @@ struct Eigenshapes {
 /// coordinate) in the space with basis N. For a separable basis every scalar eigenvector
 /// yields three eigenshapes (x, y, z) of equal frequency. Throws Error(Numerical) when
 /// Spectra does not converge.
+/// The reduced operator N^T L N, the d x d matrix whose eigenproblem this is, is formed on
+/// `backend` (Backend::reducedOperator); the small eigenproblem runs on the host.
+Eigenshapes computeEigenshapes(compute::Backend& backend, const SubspaceBasis& N, const compute::SparseMatrix& L,
+                               const EigenshapeSettings& settings = {}, EigenshapeInfo* info = nullptr);
+/// The same on the CPU reference.
 Eigenshapes computeEigenshapes(const SubspaceBasis& N, const compute::SparseMatrix& L,
                                const EigenshapeSettings& settings = {}, EigenshapeInfo* info = nullptr);
 

@@ -14,6 +14,10 @@ struct FundamentalShapeSettings {
 
 /// The fundamental shape of `vertex` along `direction` (#V x 3). Throws Error(BadInput)
 /// for a vertex out of range, Error(Usage) for a zero direction or negative smoothness.
+/// N^T L^T L N is formed on `backend` (Backend::reducedOperator), the d x d solve on the host.
+Positions fundamentalShape(compute::Backend& backend, const SubspaceBasis& N, const compute::SparseMatrix& L,
+                           Index vertex, const Eigen::Vector3d& direction, const FundamentalShapeSettings& settings = {});
+/// The same on the CPU reference.
 Positions fundamentalShape(const SubspaceBasis& N, const compute::SparseMatrix& L, Index vertex,
                            const Eigen::Vector3d& direction, const FundamentalShapeSettings& settings = {});
 

@@ -1,5 +1,7 @@
 #include "subspace/SubspaceBasis.h"
 
+#include "compute/cpu/CpuBackend.h"
+
 namespace plano::subspace {
 
 SubspaceBasis::SubspaceBasis(Eigen::MatrixXd columns, bool separable)
@@ -32,24 +34,25 @@ Eigen::VectorXd SubspaceBasis::coefficients(const Positions& X) const {
   return columns_.transpose() * Eigen::Map<const Eigen::VectorXd>(X.data(), X.size());
 }
 
+Eigen::MatrixXd SubspaceBasis::compactReducedOperator(compute::Backend& backend, const compute::SparseMatrix& S) const {
+  return backend.reducedOperator(S, columns_, separable_ ? 1 : 3);
+}
+
+Eigen::MatrixXd SubspaceBasis::reducedOperator(compute::Backend& backend, const compute::SparseMatrix& S) const {
+  const Eigen::MatrixXd compact = compactReducedOperator(backend, S);
+  if (!separable_) return compact;
+  // N = N1 (x) I_3 with coefficient 3 a + c: R = R1 (x) I_3.
+  const Eigen::Index d1 = compact.rows();
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(3 * d1, 3 * d1);
+  for (Eigen::Index a = 0; a < d1; ++a)
+    for (Eigen::Index b = 0; b < d1; ++b)
+      for (int c = 0; c < 3; ++c) R(3 * a + c, 3 * b + c) = compact(a, b);
+  return R;
+}
+
 Eigen::MatrixXd SubspaceBasis::reducedOperator(const compute::SparseMatrix& S) const {
-  if (separable_) {
-    const Eigen::MatrixXd R1 = columns_.transpose() * (S * columns_);
-    const Eigen::Index d1 = R1.rows();
-    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(3 * d1, 3 * d1);
-    for (Eigen::Index a = 0; a < d1; ++a)
-      for (Eigen::Index b = 0; b < d1; ++b)
-        for (int c = 0; c < 3; ++c) R(3 * a + c, 3 * b + c) = R1(a, b);
-    return R;
-  }
-  // (S (x) I_3) applied to each column viewed as a row-major #V x 3 matrix.
-  const Eigen::Index nv = vertexCount(), d = columns_.cols();
-  Eigen::MatrixXd SN(columns_.rows(), d);
-  for (Eigen::Index j = 0; j < d; ++j) {
-    const Eigen::Map<const Positions> Xj(columns_.col(j).data(), nv, 3);
-    Eigen::Map<Positions>(SN.col(j).data(), nv, 3) = S * Xj;
-  }
-  return columns_.transpose() * SN;
+  compute::CpuBackend cpu;
+  return reducedOperator(cpu, S);
 }
 
 Eigen::MatrixXd SubspaceBasis::coordinateRows(std::span<const Index> coordinates) const {

@@ -33,8 +33,14 @@ class SubspaceBasis {
   /// N N^T vec(X): orthogonal projection of a mesh onto the space.
   Positions project(const Positions& X) const { return shape(coefficients(X)); }
 
-  /// N^T (S (x) I_3) N for a scalar #V x #V operator S (d x d, dense).
+  /// N^T (S (x) I_3) N for a scalar #V x #V operator S (d x d, dense), computed where the
+  /// backend runs kernels (Backend::reducedOperator; for a separable basis on N1 only).
+  Eigen::MatrixXd reducedOperator(compute::Backend& backend, const compute::SparseMatrix& S) const;
+  /// The same on the CPU reference.
   Eigen::MatrixXd reducedOperator(const compute::SparseMatrix& S) const;
+  /// N1^T S N1 of a separable basis, N^T (S (x) I_3) N otherwise: the reduced operator in
+  /// the compact form (d1 x d1 or d x d).
+  Eigen::MatrixXd compactReducedOperator(compute::Backend& backend, const compute::SparseMatrix& S) const;
   /// Rows of N for the full coordinates 3 v + c listed in `coordinates` (#coordinates x d).
   Eigen::MatrixXd coordinateRows(std::span<const Index> coordinates) const;
 

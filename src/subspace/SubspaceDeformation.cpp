@@ -40,7 +40,7 @@ SubspaceDeformer::SubspaceDeformer(const LinearSpace& space, const PositionalCon
     : space_(space), constraints_(constraints), backend_(backend), settings_(settings) {
   const PolygonMesh& Y = space.source;
   constrained_ = constrainSubspace(space.N, constraints, Y.vertices, settings.rankTolerance);
-  reduced_ = space.N.reducedOperator(centredCornerMatrix(Y.faces, Y.vertexCount()));
+  reduced_ = space.N.reducedOperator(backend_, centredCornerMatrix(Y.faces, Y.vertexCount()));
   Eigen::MatrixXd H = constrained_.free.transpose() * reduced_ * constrained_.free;
   // A direction the energy ignores and the constraints leave free (a free translation when
   // nothing is fixed) would make H singular: a tiny relative Tikhonov term picks the

@@ -11,6 +11,7 @@
 #include "compute/vulkan/VulkanPcgSolver.h"
 #include "compute/vulkan/VulkanProjectiveFit.h"
 #include "compute/vulkan/VulkanReducedArap.h"
+#include "compute/vulkan/VulkanReducedOperator.h"
 #include "core/Error.h"
 
 namespace plano::compute {
@@ -144,6 +145,11 @@ std::unique_ptr<AdmmSolver> VulkanBackend::createAdmmSolver(const SparseMatrix& 
   // A global step's targets are often the ideal maps the ideal-map kernel just computed.
   kernels->bindResidentMaps(residentMaps_.get());
   return std::make_unique<AdmmSolver>(std::move(kernels), P.rows(), C.rows(), settings);
+}
+
+Eigen::MatrixXd VulkanBackend::reducedOperator(const SparseMatrix& S, const Eigen::MatrixXd& N, int coordinates) {
+  if (!reducedOperator_) reducedOperator_ = std::make_unique<vk::ReducedOperatorKernel>(*context_);
+  return reducedOperator_->run(S, N, coordinates);
 }
 
 std::unique_ptr<ReducedArapKernels> VulkanBackend::createReducedArapKernels(

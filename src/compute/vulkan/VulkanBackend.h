@@ -13,6 +13,7 @@ class ClosestRotationsKernel;
 class IdealMapsKernel;
 class ResidentFaceMaps;
 class MapPositionsKernel;
+class ReducedOperatorKernel;
 template <class T>
 class Array;
 }  // namespace plano::vk
@@ -71,6 +72,9 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<ReducedArapKernels> createReducedArapKernels(
       const std::function<ReducedArapProblem()>& problem) override;
 
+  /// Basis and S up once, the d x d result down (vk::ReducedOperatorKernel).
+  Eigen::MatrixXd reducedOperator(const SparseMatrix& S, const Eigen::MatrixXd& N, int coordinates) override;
+
   std::optional<DeviceTransfers> transfers() const override;
 
   /// The device context (device properties, validation messages).
@@ -90,6 +94,7 @@ class VulkanBackend final : public Backend {
   std::unique_ptr<vk::ResidentFaceMaps> residentMaps_;
   std::unique_ptr<vk::IdealMapsKernel> idealMaps_;
   std::unique_ptr<vk::MapPositionsKernel> mapPositions_;
+  std::unique_ptr<vk::ReducedOperatorKernel> reducedOperator_;
 };
 
 /// Create the Vulkan backend. The device can be forced with the environment variable

@@ -43,7 +43,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const std::string backend = warnComputesOnCpu(global, "dual");
+    const auto backend = makeReducedOperatorBackend(global, "dual");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);
@@ -57,7 +57,7 @@ RunFunction setup(CLI::App& app) {
       const LinearSpace space = buildLinearSpace(dual, uniformAssignment(parseSpaceKind(o->space), dual.faceCount()));
       EigenshapeSettings es;
       es.count = o->eigenshape + 1;
-      const Eigenshapes shapes = computeEigenshapes(space.N, uniformLaplacian(dual.faces, dual.vertexCount()), es);
+      const Eigenshapes shapes = computeEigenshapes(*backend, space.N, uniformLaplacian(dual.faces, dual.vertexCount()), es);
       if (o->eigenshape >= shapes.count()) {
         throwUsage("--eigenshape " + std::to_string(o->eigenshape) + " but the dual's " + o->space + " space has dimension " +
                    std::to_string(space.N.dimension()));
@@ -76,7 +76,7 @@ RunFunction setup(CLI::App& app) {
                 << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    j = baseReport("dual", backend, o->primal.empty() ? dual : mesh, stats, seconds);
+    j = baseReport("dual", backend->name(), o->primal.empty() ? dual : mesh, stats, seconds);
     j["dual_vertices"] = dual.vertexCount();
     j["dual_faces"] = dual.faceCount();
     j["dual_max_planarity"] = planarityStats(dual).max;

@@ -59,7 +59,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const std::string backend = warnComputesOnCpu(global, "explore");
+    const auto backend = makeReducedOperatorBackend(global, "explore");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     LinearSpaceSettings settings;
@@ -70,13 +70,13 @@ RunFunction setup(CLI::App& app) {
     EigenshapeSettings es;
     es.count = o->eigenshapes;
     EigenshapeInfo info;
-    const Eigenshapes shapes = computeEigenshapes(space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), es, &info);
+    const Eigenshapes shapes = computeEigenshapes(*backend, space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), es, &info);
     const auto [lo, hi] = parseBand(o->band, shapes.count());
     PolygonMesh out = mesh;
     out.vertices = bandPass(space.N, shapes, space.N.project(mesh.vertices), lo, hi, o->amplitude);
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j = baseReport("explore", backend, out, stats, seconds);
+    nlohmann::json j = baseReport("explore", backend->name(), out, stats, seconds);
     j["space"] = o->space;
     j["dimension"] = space.dof.dimension;
     j["eigenshapes"] = shapes.count();

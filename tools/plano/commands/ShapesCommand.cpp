@@ -55,7 +55,11 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const std::string backend = warnComputesOnCpu(global, "shapes");
+    // Sparse shapes (OMP on B) compute on the CPU; a fundamental shape's reduced operator
+    // runs on the backend.
+    std::unique_ptr<compute::Backend> backend;
+    const std::string backendName = o->kind == "sparse" ? warnComputesOnCpu(global, "shapes --kind sparse")
+                                                        : (backend = makeReducedOperatorBackend(global, "shapes"))->name();
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     if (o->vertex < 0 || o->vertex >= mesh.vertexCount()) {
@@ -89,7 +93,7 @@ RunFunction setup(CLI::App& app) {
       const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
       FundamentalShapeSettings fs;
       fs.smoothness = o->smoothness;
-      shape = fundamentalShape(space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), o->vertex, direction, fs);
+      shape = fundamentalShape(*backend, space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), o->vertex, direction, fs);
       base = space.N.project(mesh.vertices);
       extra = {{"dimension", space.dof.dimension}, {"smoothness", o->smoothness}};
       std::cout << "fundamental shape of vertex " << o->vertex << " in the " << o->space << " space (dimension "
@@ -99,7 +103,7 @@ RunFunction setup(CLI::App& app) {
     PolygonMesh out = mesh;
     out.vertices = base + (peak > 0.0 ? o->amplitude * boundingBoxDiagonal(mesh.vertices) / peak : 0.0) * shape;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j = baseReport("shapes", backend, out, planarityStats(out), seconds);
+    nlohmann::json j = baseReport("shapes", backendName, out, planarityStats(out), seconds);
     j["space"] = o->space;
     j["kind"] = o->kind;
     j["vertex"] = o->vertex;
