@@ -1,15 +1,23 @@
 #version 450
 // One block of R = N^T W (compute/ReducedOperator.h): R[i0 + i, j0 + j] = sum_r A[r, i]
 // B[r, j] for A a block of the basis's columns and B = (S (x) I_k) N of another block, both
-// n x (their columns) column after column, R d x d column-major. Each workgroup computes a
-// TILE x TILE block of R, reading the long dimension r in TILE-row slices through shared
-// memory: each slice of A and B is read from the buffers once per workgroup instead of once
-// per output entry, and consecutive invocations read consecutive rows.
+// n x (their columns) column after column, R d x d column-major.
+//
+// Each workgroup of 16 x 16 invocations computes a 64 x 64 block of R, each invocation a
+// 4 x 4 set of its entries (i = tx + 16 a, j = ty + 16 b) held in registers, reading the
+// long dimension r in 16-row slices through shared memory: a slice of A and of B is read
+// from the buffers once per workgroup, and each value read from shared memory feeds four
+// multiply-adds (a 16 x 16 block with one entry per invocation fed one, and paid a barrier
+// pair per 16 of them).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
-#define TILE 16
-layout(local_size_x = TILE, local_size_y = TILE) in;
+#define THREADS 16
+#define PER_THREAD 4
+#define TILE (THREADS * PER_THREAD)  // 64: vk::ReducedOperatorKernel's kTile
+#define SLICE 16
+
+layout(local_size_x = THREADS, local_size_y = THREADS) in;
 
 layout(std430, binding = 0) readonly buffer A { double a[]; };
 layout(std430, binding = 1) readonly buffer B { double b[]; };
@@ -24,25 +32,47 @@ layout(push_constant) uniform Push {
   uint d;            // leading dimension of R
 } pc;
 
-shared double sliceA[TILE][TILE];  // [column of A][row of the slice]
-shared double sliceB[TILE][TILE];
+shared double sliceA[TILE][SLICE];  // [column of A within the tile][row within the slice]
+shared double sliceB[TILE][SLICE];
 
 void main() {
   const uint tx = gl_LocalInvocationID.x;
   const uint ty = gl_LocalInvocationID.y;
-  const uint i = gl_WorkGroupID.x * TILE + tx;  // this invocation's entry (i, j)
-  const uint j = gl_WorkGroupID.y * TILE + ty;
-  // This invocation loads row r0 + tx of column (tile's first) + ty of A and of B.
-  const uint loadA = gl_WorkGroupID.x * TILE + ty;
-  const uint loadB = gl_WorkGroupID.y * TILE + ty;
-  precise double sum = 0.0;
-  for (uint r0 = 0; r0 < pc.n; r0 += TILE) {
-    const uint r = r0 + tx;
-    sliceA[ty][tx] = (r < pc.n && loadA < pc.columnsA) ? a[loadA * pc.n + r] : 0.0;
-    sliceB[ty][tx] = (r < pc.n && loadB < pc.columnsB) ? b[loadB * pc.n + r] : 0.0;
+  const uint thread = tx + THREADS * ty;
+  const uint tileA = gl_WorkGroupID.x * TILE;  // first column of A (row of R) of this block
+  const uint tileB = gl_WorkGroupID.y * TILE;
+  double sum[PER_THREAD][PER_THREAD];
+  for (uint p = 0; p < PER_THREAD; ++p)
+    for (uint q = 0; q < PER_THREAD; ++q) sum[p][q] = 0.0;
+  for (uint r0 = 0; r0 < pc.n; r0 += SLICE) {
+    // 64 x 16 values of each slice, four per invocation; consecutive invocations read
+    // consecutive rows of a column.
+    for (uint e = thread; e < TILE * SLICE; e += THREADS * THREADS) {
+      const uint row = e % SLICE;
+      const uint column = e / SLICE;
+      const uint r = r0 + row;
+      sliceA[column][row] = (r < pc.n && tileA + column < pc.columnsA) ? a[(tileA + column) * pc.n + r] : 0.0;
+      sliceB[column][row] = (r < pc.n && tileB + column < pc.columnsB) ? b[(tileB + column) * pc.n + r] : 0.0;
+    }
     barrier();
-    for (uint k = 0; k < TILE; ++k) sum += sliceA[tx][k] * sliceB[ty][k];
+    for (uint k = 0; k < SLICE; ++k) {
+      double x[PER_THREAD], y[PER_THREAD];
+      for (uint p = 0; p < PER_THREAD; ++p) {
+        x[p] = sliceA[tx + THREADS * p][k];
+        y[p] = sliceB[ty + THREADS * p][k];
+      }
+      for (uint p = 0; p < PER_THREAD; ++p)
+        for (uint q = 0; q < PER_THREAD; ++q) {
+          precise double t = sum[p][q] + x[p] * y[q];
+          sum[p][q] = t;
+        }
+    }
     barrier();
   }
-  if (i < pc.columnsA && j < pc.columnsB) result[(pc.firstColumn + j) * pc.d + pc.firstRow + i] = sum;
+  for (uint p = 0; p < PER_THREAD; ++p)
+    for (uint q = 0; q < PER_THREAD; ++q) {
+      const uint i = tileA + tx + THREADS * p;
+      const uint j = tileB + ty + THREADS * q;
+      if (i < pc.columnsA && j < pc.columnsB) result[(pc.firstColumn + j) * pc.d + pc.firstRow + i] = sum[p][q];
+    }
 }

@@ -46,14 +46,16 @@ double relativeDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 using VulkanReducedOperator = VulkanTest;
 
 TEST_F(VulkanReducedOperator, MatchesTheCpuOnRandomOperatorsAndBases) {
-  // Sizes off the kernel's 16-entry tiles, one and three coordinates per vertex.
+  // Sizes off the kernel's 64-column tiles and 16-row slices (150 columns: three tiles per
+  // side), one and three coordinates per vertex.
   const compute::SparseMatrix S = randomOperator(301, 7, 1);
-  for (int k : {1, 3}) {
-    const Eigen::MatrixXd N = randomBasis(k * 301, k == 1 ? 37 : 29, 2 + k);
+  for (const auto& [k, columns] : {std::pair{1, 37}, std::pair{3, 29}, std::pair{1, 150}}) {
+    const Eigen::MatrixXd N = randomBasis(k * 301, columns, 2 + k + columns);
     const Eigen::MatrixXd R = backend().reducedOperator(S, N, k);
     ASSERT_EQ(R.rows(), N.cols());
     ASSERT_EQ(R.cols(), N.cols());
-    EXPECT_LT(relativeDifference(R, compute::reducedOperatorReference(S, N, k)), 1e-12) << k << " coordinates";
+    EXPECT_LT(relativeDifference(R, compute::reducedOperatorReference(S, N, k)), 1e-12)
+        << k << " coordinates, " << columns << " columns";
   }
 }
 
@@ -61,7 +63,7 @@ TEST_F(VulkanReducedOperator, ABasisSplitIntoManyBlocksGivesTheSameOperator) {
   const compute::SparseMatrix S = randomOperator(200, 5, 4);
   const Eigen::MatrixXd N = randomBasis(3 * 200, 41, 5);
   // Five columns per block: nine blocks of columns, 81 products of blocks.
-  vk::ReducedOperatorKernel kernel(context(), 5 * N.rows() * sizeof(double));
+  vk::ReducedOperatorKernel kernel(context(), 5 * static_cast<std::size_t>(N.rows()) * sizeof(double));
   const Eigen::MatrixXd blocked = kernel.run(S, N, 3);
   EXPECT_LT(relativeDifference(blocked, compute::reducedOperatorReference(S, N, 3)), 1e-12);
   EXPECT_LT(relativeDifference(blocked, backend().reducedOperator(S, N, 3)), 1e-13);

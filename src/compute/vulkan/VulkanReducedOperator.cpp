@@ -12,7 +12,7 @@
 namespace plano::vk {
 namespace {
 
-constexpr std::uint32_t kTile = 16;  // shaders/reduced_gemm.comp's TILE
+constexpr std::uint32_t kTile = 64;  // shaders/reduced_gemm.comp's TILE: rows and columns of R per workgroup
 
 struct SpmmPush {
   std::uint32_t vertices;
