@@ -69,6 +69,13 @@ TEST_F(VulkanReducedOperator, ABasisSplitIntoManyBlocksGivesTheSameOperator) {
   EXPECT_LT(relativeDifference(blocked, backend().reducedOperator(S, N, 3)), 1e-13);
 }
 
+TEST_F(VulkanReducedOperator, ATallBasisSplitIntoChunksOfRowsGivesTheSameOperator) {
+  // 4 500 rows: three chunks of the long dimension (the last one short), summed at the end.
+  const compute::SparseMatrix S = randomOperator(1500, 6, 10);
+  const Eigen::MatrixXd N = randomBasis(3 * 1500, 70, 11);
+  EXPECT_LT(relativeDifference(backend().reducedOperator(S, N, 3), compute::reducedOperatorReference(S, N, 3)), 1e-12);
+}
+
 TEST_F(VulkanReducedOperator, OnlyTheSmallResultComesBack) {
   const compute::SparseMatrix S = randomOperator(500, 6, 6);
   const Eigen::MatrixXd N = randomBasis(500, 24, 7);
