@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/MeshLaplacian.h"
@@ -10,7 +11,8 @@
 
 namespace plano::subspace {
 
-PolygonMesh liftWithAffineSpace(const PolygonMesh& flat, const LiftSettings& settings, LiftInfo* info) {
+PolygonMesh liftWithAffineSpace(compute::Backend& backend, const PolygonMesh& flat, const LiftSettings& settings,
+                                LiftInfo* info) {
   const Index nv = flat.vertexCount();
   const double diagonal = boundingBoxDiagonal(flat.vertices);
   if (!(diagonal > 0.0)) throwBadInput("lifting: the mesh has no extent");
@@ -35,7 +37,7 @@ PolygonMesh liftWithAffineSpace(const PolygonMesh& flat, const LiftSettings& set
       throwUsage("lifting: eigenshape " + std::to_string(settings.eigenshape) + " out of range (" +
                  std::to_string(liftings) + " non-planar liftings)");
     }
-    const Eigen::MatrixXd R = M.transpose() * (uniformLaplacian(flat.faces, nv) * M);
+    const Eigen::MatrixXd R = backend.reducedOperator(uniformLaplacian(flat.faces, nv), M, 1);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (R + R.transpose()));
     h = M * eig.eigenvectors().col(settings.eigenshape);
   } else {
@@ -66,6 +68,11 @@ PolygonMesh liftWithAffineSpace(const PolygonMesh& flat, const LiftSettings& set
     info->maxHeight = lifted.vertices.col(2).cwiseAbs().maxCoeff();
   }
   return lifted;
+}
+
+PolygonMesh liftWithAffineSpace(const PolygonMesh& flat, const LiftSettings& settings, LiftInfo* info) {
+  compute::CpuBackend cpu;
+  return liftWithAffineSpace(cpu, flat, settings, info);
 }
 
 }  // namespace plano::subspace

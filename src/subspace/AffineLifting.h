@@ -5,6 +5,7 @@
 // are its liftings: heights that keep every face planar. The planar liftings (1, x, y)
 // are removed; what remains is lifted either by its lowest-frequency eigenshape or by a
 // handle (one vertex raised, the boundary held at zero as far as the space allows).
+#include "compute/Backend.h"
 #include "mesh/PolygonMesh.h"
 
 namespace plano::subspace {
@@ -26,6 +27,11 @@ struct LiftInfo {
 /// Lift a flat mesh lying in the plane z = 0. Throws Error(BadInput) when the mesh is not
 /// flat, Error(Numerical) when the topology only admits planar liftings (e.g. 3-regular
 /// graphs, Appendix 2), Error(Usage) for an eigenshape index out of range.
+/// The eigenshape kind's reduced operator M^T L M runs on `backend` (Backend::reducedOperator);
+/// the affine space's basis and the small eigenproblem on the host.
+PolygonMesh liftWithAffineSpace(compute::Backend& backend, const PolygonMesh& flat, const LiftSettings& settings = {},
+                                LiftInfo* info = nullptr);
+/// The same on the CPU reference.
 PolygonMesh liftWithAffineSpace(const PolygonMesh& flat, const LiftSettings& settings = {}, LiftInfo* info = nullptr);
 
 }  // namespace plano::subspace

@@ -1,10 +1,11 @@
 #include "subspace/TutteEmbedding.h"
 
-#include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
 #include "subspace/SubspaceTopology.h"
 
@@ -22,7 +23,8 @@ double signedArea(const Positions& X, std::span<const Index> face) {
 
 }  // namespace
 
-Positions tutteEmbedding(const FaceList& faces, Index vertexCount, const TutteSettings& settings, TutteInfo* info) {
+Positions tutteEmbedding(compute::Backend& backend, const FaceList& faces, Index vertexCount,
+                         const TutteSettings& settings, TutteInfo* info) {
   const SubspaceTopology t = computeTopology(faces, vertexCount);
   if (t.components != 1 || t.boundaryLoopCount() != 1 || t.genus != 0) {
     throwBadInput("Tutte embedding needs a disk: the mesh has " + std::to_string(t.components) + " component(s), " +
@@ -57,12 +59,20 @@ Positions tutteEmbedding(const FaceList& faces, Index vertexCount, const TutteSe
     }
   }
   if (ni > 0) {
-    Eigen::SparseMatrix<double> L(ni, ni);
+    compute::SparseMatrix L(ni, ni);
     L.setFromTriplets(triplets.begin(), triplets.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(L);
-    if (solver.info() != Eigen::Success) throwNumerical("Tutte embedding: factorization failed");
-    const Eigen::MatrixX2d interior = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !interior.allFinite()) throwNumerical("Tutte embedding: solve failed");
+    L.makeCompressed();
+    // An iterative backend's error in x is its residual times L's condition number, which
+    // grows with the mesh: a tolerance near rounding keeps the embedding the direct solve's.
+    compute::LinearSolverSettings solverSettings;
+    solverSettings.relativeTolerance = 1e-13;
+    solverSettings.maxIterations = static_cast<int>(std::max<Index>(10000, 4 * ni));
+    Eigen::MatrixXd interior = Eigen::MatrixXd::Zero(ni, 2);
+    const compute::LinearSolveInfo solve = backend.createSpdSolver(L, solverSettings)->solve(rhs, interior);
+    if (!solve.converged || !interior.allFinite()) {
+      throwNumerical("Tutte embedding: the solve failed (" + std::to_string(solve.iterations) +
+                     " iterations, relative residual " + std::to_string(solve.relativeResidual) + ")");
+    }
     for (Index v = 0; v < vertexCount; ++v)
       if (slot[v] >= 0) X.row(v).head<2>() = interior.row(slot[v]);
   }
@@ -76,6 +86,11 @@ Positions tutteEmbedding(const FaceList& faces, Index vertexCount, const TutteSe
   for (Index f = 0; f < faces.size(); ++f) local.flippedFaces += signedArea(X, faces[f]) <= 0.0 ? 1 : 0;
   if (info) *info = local;
   return X;
+}
+
+Positions tutteEmbedding(const FaceList& faces, Index vertexCount, const TutteSettings& settings, TutteInfo* info) {
+  compute::CpuBackend cpu;
+  return tutteEmbedding(cpu, faces, vertexCount, settings, info);
 }
 
 }  // namespace plano::subspace

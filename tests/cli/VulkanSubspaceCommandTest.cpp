@@ -1,7 +1,8 @@
 // `plano --backend vulkan deform --space ...`: the subspace deformation's iterations run on
 // the device (vk::ReducedArapKernels) and give the CPU's mesh and iteration count; a device
 // lost in the middle exits with 5 and writes no mesh. `plano --backend vulkan explore`: the
-// eigenshapes' reduced operator is formed on the device and gives the CPU's frequencies.
+// eigenshapes' reduced operator is formed on the device and gives the CPU's frequencies;
+// `plano --backend vulkan embed`: the Tutte solve and the lifting run there and give the CPU's mesh.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -76,6 +77,26 @@ TEST_F(VulkanSubspaceCommand, ExploreFormsTheReducedOperatorOnTheDeviceAndGivesT
   // eigenvalue's space rounding may pick other (equally valid) eigenshapes.
   for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(b[k], a[k], 1e-10 * a.back()) << k;
   EXPECT_LT(report("device.json")["subspace_residual"].get<double>(), 1e-9);
+}
+
+TEST_F(VulkanSubspaceCommand, EmbedSolvesOnTheDeviceAndWritesTheCpusMesh) {
+  writeMesh(dir_ / "grid.obj", generate::hyparGrid(6));
+  const auto embed = [&](const std::string& backend, const std::string& out, const std::string& report) {
+    return runTool("--backend " + backend + " embed " + path("grid.obj") + " --lift handle -o " + path(out) +
+                   " --report " + path(report));
+  };
+  const ToolResult cpu = embed("cpu", "cpu.obj", "cpu.json");
+  const ToolResult device = embed("vulkan", "device.obj", "device.json");
+  ASSERT_EQ(cpu.exitCode, 0) << cpu.err;
+  ASSERT_EQ(device.exitCode, 0) << device.err;
+  EXPECT_NE(device.err.find("the Tutte solve and the lifting's reduced operator run on vulkan"), std::string::npos)
+      << device.err;
+  EXPECT_EQ(report("device.json")["backend"].get<std::string>().rfind("vulkan", 0), 0u);
+  EXPECT_EQ(report("device.json")["flipped_faces"], 0);
+  const PolygonMesh x = readMesh(dir_ / "cpu.obj");
+  const PolygonMesh y = readMesh(dir_ / "device.obj");
+  ASSERT_EQ(x.vertexCount(), y.vertexCount());
+  EXPECT_LT((x.vertices - y.vertices).rowwise().norm().maxCoeff(), 1e-9 * boundingBoxDiagonal(x.vertices));
 }
 
 TEST_F(VulkanSubspaceCommand, LostDeviceDuringExploreExitsWithFiveAndWritesNoMesh) {

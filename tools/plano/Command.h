@@ -40,17 +40,19 @@ struct CommandRegistration {
 /// Create the backend the user asked for, printing a fallback warning on stderr.
 std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options);
 
-/// For a command that computes on the CPU whatever the backend (subspace, embed, sparse
-/// shapes: their factorizations and embeddings have no device kernels): a warning on
+/// For a command that computes on the CPU whatever the backend (subspace, sparse shapes:
+/// their factorizations have no device kernels): a warning on
 /// stderr, even with --quiet, when --backend vulkan asked for the device, so that nobody
 /// takes its results or timings for the device's. Returns the backend name for the report.
 std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command);
 
-/// For a command whose reduced operator N^T S N (the d x d matrix of eigenshapes and
-/// fundamental shapes, compute::Backend::reducedOperator) runs on the backend while the
-/// linear space's basis and the small dense problem run on the CPU: the backend asked for,
-/// and with a device backend a line on stderr (unless --quiet) saying which part runs where.
-std::unique_ptr<compute::Backend> makeReducedOperatorBackend(const GlobalOptions& options, const std::string& command);
+/// For a linear-space command whose heavy products run on the backend (`deviceWork`, e.g.
+/// "the reduced operator": the d x d matrix N^T S N of eigenshapes and fundamental shapes,
+/// compute::Backend::reducedOperator) while the linear space's basis and the small dense
+/// problem run on the CPU: the backend asked for, and with a device backend a line on stderr
+/// (unless --quiet) saying which part runs where.
+std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& options, const std::string& command,
+                                                         const std::string& deviceWork);
 
 /// Progress line on stderr unless --quiet.
 void progress(const GlobalOptions& options, const std::string& message);

@@ -25,17 +25,18 @@ std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& c
   if (options.backend == "vulkan") {
     std::cerr << "warning: plano " << command
               << " computes on the CPU: the linear-space factorizations have no Vulkan kernels (--backend vulkan "
-                 "applies to subdivide, planarize, prescribe, interpolate and deform, and to the reduced operators "
-                 "of explore, dual and fundamental shapes)"
+                 "applies to subdivide, planarize, prescribe, interpolate and deform, to the reduced operators "
+                 "of explore, dual and fundamental shapes, and to embed's solve)"
               << std::endl;
   }
   return "cpu";
 }
 
-std::unique_ptr<compute::Backend> makeReducedOperatorBackend(const GlobalOptions& options, const std::string& command) {
+std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& options, const std::string& command,
+                                                         const std::string& deviceWork) {
   auto backend = makeBackend(options);
   if (backend->kind() != compute::BackendKind::Cpu && !options.quiet) {
-    std::cerr << "plano " << command << ": the reduced operator runs on " << backend->name()
+    std::cerr << "plano " << command << ": " << deviceWork << " on " << backend->name()
               << "; the linear space's basis and the small dense problem on the CPU" << std::endl;
   }
   return backend;

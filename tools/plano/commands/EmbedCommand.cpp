@@ -39,11 +39,12 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const std::string backend = warnComputesOnCpu(global, "embed");
+    const auto backend =
+        makeLinearSpaceBackend(global, "embed", "the Tutte solve and the lifting's reduced operator run");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh topology = readMesh(o->input);
     TutteInfo tutte;
-    PolygonMesh out{tutteEmbedding(topology.faces, topology.vertexCount(), {}, &tutte), topology.faces};
+    PolygonMesh out{tutteEmbedding(*backend, topology.faces, topology.vertexCount(), {}, &tutte), topology.faces};
     progress(global, "Tutte embedding: " + std::to_string(tutte.boundaryVertices) + " boundary vertices, " +
                          std::to_string(tutte.flippedFaces) + " flipped faces");
     LiftInfo lift;
@@ -53,11 +54,11 @@ RunFunction setup(CLI::App& app) {
       settings.height = o->height;
       settings.eigenshape = o->eigenshape;
       settings.handleVertex = o->vertex;
-      out = liftWithAffineSpace(out, settings, &lift);
+      out = liftWithAffineSpace(*backend, out, settings, &lift);
     }
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j = baseReport("embed", backend, out, stats, seconds);
+    nlohmann::json j = baseReport("embed", backend->name(), out, stats, seconds);
     j["boundary_vertices"] = tutte.boundaryVertices;
     j["flipped_faces"] = tutte.flippedFaces;
     j["lift"] = o->lift;

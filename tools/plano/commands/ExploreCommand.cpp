@@ -59,7 +59,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const auto backend = makeReducedOperatorBackend(global, "explore");
+    const auto backend = makeLinearSpaceBackend(global, "explore", "the reduced operator runs");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     LinearSpaceSettings settings;

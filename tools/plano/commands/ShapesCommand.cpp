@@ -59,7 +59,7 @@ RunFunction setup(CLI::App& app) {
     // runs on the backend.
     std::unique_ptr<compute::Backend> backend;
     const std::string backendName = o->kind == "sparse" ? warnComputesOnCpu(global, "shapes --kind sparse")
-                                                        : (backend = makeReducedOperatorBackend(global, "shapes"))->name();
+                                                        : (backend = makeLinearSpaceBackend(global, "shapes", "the reduced operator runs"))->name();
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     if (o->vertex < 0 || o->vertex >= mesh.vertexCount()) {
