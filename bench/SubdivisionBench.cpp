@@ -84,6 +84,46 @@ BENCHMARK_CAPTURE(BM_PqSubdivision, cube, true, BackendChoice::Cpu)
 BENCHMARK_CAPTURE(BM_PqSubdivision, cube_vulkan, true, BackendChoice::Vulkan)
     ->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 
+/// One planar-quad level at the standard sizes: the level that takes the cube's planar-quad
+/// hierarchy (paper Fig. 2) to about `faces` faces (6 * 4^k: 6 144, 98 304, ...), from the
+/// PQ mesh of the level below (made untimed, on the CPU). A real level of a hierarchy:
+/// extraordinary vertices, targets whose non-planarity shrinks with the faces.
+void BM_PqSubdivisionLevel(benchmark::State& state, BackendChoice choice) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  int levelsBelow = 0;
+  for (std::int64_t faces = 6 * 4; 4 * faces <= 3 * state.range(0) / 2; faces *= 4) ++levelsBelow;
+  plano::PolygonMesh base = plano::generate::cube();
+  if (levelsBelow > 0) {
+    plano::projective::PqSubdivisionSettings below;
+    below.levels = levelsBelow;
+    base = plano::projective::subdividePlanarQuads(*plano::compute::createBackend(BackendChoice::Cpu), base, below)
+               .finestMesh();
+  }
+  const plano::bench::MemoryCounters memory(state, backend);
+  plano::projective::PqSubdivisionSettings settings;
+  settings.levels = 1;
+  plano::projective::PqSubdivisionInfo info;
+  for (auto _ : state) {
+    const auto result = plano::projective::subdividePlanarQuads(*backend, base, settings);
+    info = result.info;
+    benchmark::DoNotOptimize(result.positions.back().data());
+  }
+  const auto& level = info.levels.back();
+  int admm = 0;
+  for (const auto& iteration : level.iterations) admm += iteration.admmIterations;
+  state.counters["faces"] = static_cast<double>(level.faces);
+  state.counters["iterations"] = static_cast<double>(level.iterations.size());
+  state.counters["admm_iterations"] = admm;
+  state.counters["max_planarity_pct"] = level.planarity.max;
+  plano::bench::setThroughput(state, static_cast<double>(level.faces));
+}
+
+BENCHMARK_CAPTURE(BM_PqSubdivisionLevel, cpu, BackendChoice::Cpu)
+    ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_PqSubdivisionLevel, vulkan, BackendChoice::Vulkan)
+    ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
 // ---- multi-resolution vs direct deformation (paper §6, Table 1) -------------------
 
 /// Yas-Island scale: 16 x 16 = 256 coarse quads, two four-point PQ levels = 4096 fine quads;
