@@ -8,11 +8,17 @@
 // rounding floor of a solve whose own target is relative to its warm start's residual.
 // NaN counts as not converged, so that it reaches the iterate. state: [0]
 // done flag of this solve, [1] iterations run, [2] solves stopped by the recorded cap,
-// [3] abs^2, an absolute bound the host derives from the ADMM's residuals (compute/Admm.h).
+// [3] abs^2, an absolute bound the host derives from the ADMM's residuals (compute/Admm.h),
+// [STATE_SOLVE_START] [1] when this solve began, [STATE_LARGEST] the most iterations a
+// counted solve ran since the ADMM's start (the host sizes the next blocks' recordings by it).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
 layout(local_size_x = 1) in;
+
+// vk::AdmmKernels' State slots kSolveStart and kLargestSolve.
+#define STATE_SOLVE_START 20
+#define STATE_LARGEST 21
 
 layout(std430, binding = 0) readonly buffer Scalars { double scalars[]; };
 layout(std430, binding = 1) buffer State { double state[]; };
@@ -26,13 +32,16 @@ layout(push_constant) uniform Push {
   uint groupsColumn;     // workgroups per column of the fused PCG kernels
   uint groupsDirection;  // workgroups of the direction update
   uint slotFloor;  // b.z of the right-hand side for the rounding floor; ~0u: none
-  uint pad;
+  uint countLargest;  // 1: this solve counts into STATE_LARGEST
   double tolerance2;
   double floor2;
 } pc;
 
 void main() {
-  if (pc.mode == 0) state[0] = 0.0;
+  if (pc.mode == 0) {
+    state[0] = 0.0;
+    state[STATE_SOLVE_START] = state[1];
+  }
   bool running = state[0] == 0.0;
   if (running) {
     bool any = false;
@@ -50,6 +59,9 @@ void main() {
   }
   if (running) {
     state[1] += 1.0;
+    if (pc.countLargest != 0u) {
+      state[STATE_LARGEST] = max(state[STATE_LARGEST], state[1] - state[STATE_SOLVE_START]);
+    }
   } else {
     state[0] = 1.0;
   }

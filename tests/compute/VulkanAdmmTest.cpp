@@ -161,6 +161,34 @@ TEST_F(VulkanAdmm, RandomBoxQpsGiveTheHostIterates) {
   }
 }
 
+TEST_F(VulkanAdmm, ShortInnerSolvesShrinkTheRecordedCapAndKeepTheHostIterates) {
+  // Warm-started solves of a steady ADMM take a few PCG iterations: after the first check
+  // the blocks record a small margin over the longest, not kInitialInnerIterations, with the
+  // host's iterates and iteration count.
+  // P = I, boxes only (no stiff equality rows) and a fixed rho: K = (1 + sigma) I + rho C^T C
+  // is well conditioned.
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings;
+  settings.adaptiveRho = false;
+  BoxQp qp = randomBoxQp(60, 45, 2);
+  qp.P.setIdentity();
+  qp.P.makeCompressed();
+  qp.lower.array() -= 0.05;
+  qp.upper.array() += 0.05;
+  settings.maxIterations = 300;  // at most thirty checks (the attempt may end unconverged, as the host's)
+  const AdmmRun host = runAdmm(cpu, qp, settings);
+  ASSERT_GT(host.info.iterations, 3 * settings.checkInterval);
+  auto kernels = std::make_unique<vk::AdmmKernels>(context(), qp.P, qp.C, settings, vk::AdmmRecording::MultiDispatch);
+  const vk::AdmmKernels& watched = *kernels;
+  compute::AdmmSolver solver(std::move(kernels), qp.P.rows(), qp.C.rows(), settings);
+  const AdmmRun device = runAdmm(solver, qp);
+  expectAgreement(device, host, settings, 1e-8);
+  EXPECT_EQ(device.info.iterations, host.info.iterations);
+  EXPECT_EQ(device.info.inexactSolves, 0);
+  EXPECT_LT(watched.innerIterationCap(), vk::AdmmKernels::kInitialInnerIterations);
+  EXPECT_GE(watched.innerIterationCap(), vk::AdmmKernels::kMinInnerIterations);
+}
+
 TEST_F(VulkanAdmm, RhoUpdatesAndWarmStartsCarryOverLikeTheHost) {
   // Two solves through one solver: the second starts from the first's rho and iterates.
   compute::CpuBackend cpu;

@@ -17,7 +17,7 @@ namespace {
 
 // Push constants of the ADMM kernels (layouts of the shaders' Push blocks).
 struct ControlPush {
-  std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, slotFloor, pad;
+  std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, slotFloor, countLargest;
   double tolerance2, floor2;
 };
 constexpr std::uint32_t kNoFloor = ~0u;
@@ -65,8 +65,11 @@ enum State : std::uint32_t {
   kStateBz = kStateRz + AdmmKernels::kSingleWorkgroupColumns,
   kStateRr = kStateBz + AdmmKernels::kSingleWorkgroupColumns,
   kStateEpsilon = kStateRr + AdmmKernels::kSingleWorkgroupColumns,  ///< A relaxed start's (admm_relaxed_bounds)
+  kSolveStart,    ///< pcg_control: kInnerIterations when the current solve began
+  kLargestSolve,  ///< pcg_control: the most iterations a counted solve ran since start()
   kStateSize
 };
+static_assert(kSolveStart == 20 && kLargestSolve == 21, "shaders/pcg_control.comp's STATE_SOLVE_START, STATE_LARGEST");
 // llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
 // single-workgroup kernel's budget keeps its estimate below half of that.
 constexpr std::uint64_t kCpuLoopBackEdges = 32768;
@@ -432,6 +435,11 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   }
   assembleK(rho);
   longFirstSolve_ = true;
+  // The solves after a new rho are harder than those a shrunk cap was sized by.
+  if (innerIterations_ < kInitialInnerIterations) {
+    innerIterations_ = std::min(kInitialInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+    if (workspace_) workspace_->blocks.clear();
+  }
 }
 
 void AdmmKernels::assembleK1(const std::vector<double>& rowScales) {
@@ -727,7 +735,8 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   la.dot(s, w.rhs, w.Kp, w.pcg, target == SolveTarget::RightHandSide ? kBz : kRhsBz);
 }
 
-void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd) {
+void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd,
+                                   bool countLargest) {
   Workspace& w = *workspace_;
   const std::uint32_t k = w.k;
   const std::uint32_t nk = n_ * k;
@@ -746,7 +755,9 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   const double floor2 = kPolishRoundingFloor * kPolishRoundingFloor;
   auto control = [&](std::uint32_t mode, std::uint32_t slotRz) {
     s.dispatch(control_, *w.controlSet,
-               ControlPush{k, slotRz, kBz, mode, groups, directionGroups, floorSlot, 0, tolerance2, floor2}, 1);
+               ControlPush{k, slotRz, kBz, mode, groups, directionGroups, floorSlot, countLargest ? 1u : 0u,
+                           tolerance2, floor2},
+               1);
     s.barrier();
   };
   control(continuation ? 1 : 0, parity == 0 ? kRzEven : kRzOdd);
@@ -777,13 +788,13 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   }
 }
 
-void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations) {
+void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest) {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
   const std::uint32_t mk = m_ * w.k;
 
   recordRightHandSide(s);
-  recordInnerSolve(s, innerIterations);
+  recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, false, countLargest);
 
   // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
   const double alpha = settings_.relaxation;
@@ -839,8 +850,11 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
   return recordedOnce(slot, context_, [&](Sequence& s) {
     const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+    // Every solve counts into kLargestSolve but a long first one, whose poor warm start says
+    // nothing about the ones that follow.
     for (int i = 0; i < count; ++i) {
-      recordIteration(s, i == count - 1, i == 0 && longFirstSolve ? largest : innerIterations_);
+      const bool longSolve = i == 0 && longFirstSolve;
+      recordIteration(s, i == count - 1, longSolve ? largest : innerIterations_, !longSolve);
     }
   });
 }
@@ -1013,6 +1027,15 @@ compute::AdmmMeasures AdmmKernels::measure() {
   if (!w.singleWorkgroup && s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
     innerIterations_ = std::min(2 * innerIterations_, largest);
     w.blocks.clear();  // re-recorded with the new cap on their next use
+  } else if (!w.singleWorkgroup && s.inexactSolves == cappedSolves_ && state[kLargestSolve] > 0.0) {
+    // Every recorded iteration past a solve's convergence still costs its (empty)
+    // dispatches: the cap shrinks to a margin over the longest solve since start().
+    int cap = kMinInnerIterations;
+    while (cap < largest && cap < kInnerIterationMargin * state[kLargestSolve]) cap *= 2;
+    if (cap < innerIterations_) {
+      innerIterations_ = cap;
+      w.blocks.clear();
+    }
   }
   cappedSolves_ = s.inexactSolves;
   return s;

@@ -30,7 +30,8 @@
 // read-back. A solve that needs more than the cap continues from its warm start in the
 // next ADMM iteration (an inexact ADMM step, counted in AdmmInfo::inexactSolves); when a
 // check sees one, the cap doubles for the following blocks (re-recorded), up to
-// kMaxInnerIterations. The first iteration after start() or a rho update, whose warm
+// kMaxInnerIterations; when the solves since the start are short, it shrinks
+// (kMinInnerIterations), and a rho update restores at least kInitialInnerIterations. The first iteration after start() or a rho update, whose warm
 // start is the poorest, always gets kMaxInnerIterations. A fixed count without the flag would either waste work or stop
 // short on every solve.
 //
@@ -68,6 +69,18 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// cap bounds the recording's size (empty dispatches are not free).
   static constexpr int kInitialInnerIterations = 256;
   static constexpr int kMaxInnerIterations = 1024;
+  /// After a check whose block capped no solve, the cap shrinks to the smallest power of two
+  /// (at least kMinInnerIterations) over kInnerIterationMargin times the longest solve
+  /// since start() (the first solves after start() or a rho update excluded): warm-started
+  /// solves of a steady ADMM often need a few iterations, and each recorded one past them
+  /// costs its empty dispatches (the cube's second PQ level, 96 faces: ~1 PCG iteration per
+  /// solve against 256 recorded; 70.6 -> 46.3 s on lavapipe, the same 4 190 ADMM and 4 214
+  /// PCG iterations). The longest since start(), not the last block's, and back to the
+  /// initial cap after a rho update: solves of a stiff QP vary by tens of iterations between
+  /// blocks, and a capped solve's inexact step changes the ADMM's path (the 144-face exact
+  /// step's rho history differed from the host's with a per-block cap).
+  static constexpr int kMinInnerIterations = 16;
+  static constexpr int kInnerIterationMargin = 4;
   /// Recorded PCG iterations per run of a polish solve (refineActiveSet), which continues
   /// until the solve converges: the recorded ones past convergence still cost their
   /// (empty) dispatches. Warm-started at the ADMM's solution a solve that only needs to
@@ -141,6 +154,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   void setLinearTolerance(double tolerance) override;
   /// Whether the current workspace (after start()) records one dispatch per block.
   bool singleWorkgroup() const;
+  /// PCG iterations recorded per ADMM iteration in the current blocks (the cap above).
+  int innerIterationCap() const { return innerIterations_; }
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
@@ -208,9 +223,10 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// r = b - K xTilde, its preconditioned residual, the stopping target's b.z and, for the
   /// polish's solves, b's (the rounding floor's scale).
   void recordPcgStart(Sequence& s, SolveTarget target);
+  /// `countLargest`: the solve's iterations count into the longest solve (kMinInnerIterations).
   void recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target = SolveTarget::RightHandSide,
-                        bool firstOdd = false);
-  void recordIteration(Sequence& s, bool saveDual, int innerIterations);
+                        bool firstOdd = false, bool countLargest = false);
+  void recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest);
   void recordPolish();
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
   void iterateSingleWorkgroup(int count);
