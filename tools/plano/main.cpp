@@ -26,7 +26,7 @@ std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& c
     std::cerr << "warning: plano " << command
               << " computes on the CPU: the linear-space factorizations have no Vulkan kernels (--backend vulkan "
                  "applies to subdivide, planarize, prescribe, interpolate and deform, to the reduced operators "
-                 "of explore, dual and fundamental shapes, and to embed's solve)"
+                 "of explore, dual --primal and shapes --kind fundamental, and to embed)"
               << std::endl;
   }
   return "cpu";

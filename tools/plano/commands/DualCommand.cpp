@@ -43,7 +43,11 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    const auto backend = makeLinearSpaceBackend(global, "dual", "the reduced operator runs");
+    // The dual alone is geometry on the CPU; exploring it forms a reduced operator on the backend.
+    std::unique_ptr<compute::Backend> backend;
+    const std::string backendName =
+        o->primal.empty() ? warnComputesOnCpu(global, "dual")
+                          : (backend = makeLinearSpaceBackend(global, "dual", "the reduced operator runs"))->name();
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);
@@ -76,7 +80,7 @@ RunFunction setup(CLI::App& app) {
                 << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    j = baseReport("dual", backend->name(), o->primal.empty() ? dual : mesh, stats, seconds);
+    j = baseReport("dual", backendName, o->primal.empty() ? dual : mesh, stats, seconds);
     j["dual_vertices"] = dual.vertexCount();
     j["dual_faces"] = dual.faceCount();
     j["dual_max_planarity"] = planarityStats(dual).max;
