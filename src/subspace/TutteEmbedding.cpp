@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 
 #include "compute/cpu/CpuBackend.h"
@@ -70,8 +71,10 @@ Positions tutteEmbedding(compute::Backend& backend, const FaceList& faces, Index
     Eigen::MatrixXd interior = Eigen::MatrixXd::Zero(ni, 2);
     const compute::LinearSolveInfo solve = backend.createSpdSolver(L, solverSettings)->solve(rhs, interior);
     if (!solve.converged || !interior.allFinite()) {
-      throwNumerical("Tutte embedding: the solve failed (" + std::to_string(solve.iterations) +
-                     " iterations, relative residual " + std::to_string(solve.relativeResidual) + ")");
+      std::ostringstream message;
+      message << "Tutte embedding: the solve failed (" << solve.iterations << " iterations, relative residual "
+              << solve.relativeResidual << ")";
+      throwNumerical(message.str());
     }
     for (Index v = 0; v < vertexCount; ++v)
       if (slot[v] >= 0) X.row(v).head<2>() = interior.row(slot[v]);

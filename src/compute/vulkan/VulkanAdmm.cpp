@@ -356,7 +356,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       negatedMaps_(context, "admm_negated_maps", 2, sizeof(NegatedMapsPush)),
       activeFlags_(context, "admm_active_flags", 2, sizeof(ActiveFlagsPush)),
       assembly_(context),
-      innerIterations_(std::min(kInitialInnerIterations, std::max(1, settings.linearSolver.maxIterations))) {
+      innerIterations_(withinSolverLimit(kInitialInnerIterations)) {
   C_.makeCompressed();
   Ct_.makeCompressed();
   k0Values_.upload({K0_.valuePtr(), static_cast<std::size_t>(K0_.nonZeros())});
@@ -437,7 +437,7 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   longFirstSolve_ = true;
   // The solves after a new rho are harder than those a shrunk cap was sized by.
   if (innerIterations_ < kInitialInnerIterations) {
-    innerIterations_ = std::min(kInitialInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+    innerIterations_ = withinSolverLimit(kInitialInnerIterations);
     if (workspace_) workspace_->blocks.clear();
   }
 }
@@ -809,7 +809,7 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
 void AdmmKernels::recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin) {
   Workspace& w = *workspace_;
   const double tolerance = settings_.linearSolver.relativeTolerance;
-  const auto cap = static_cast<std::uint32_t>(std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations)));
+  const auto cap = static_cast<std::uint32_t>(withinSolverLimit(kMaxInnerIterations));
   const DescriptorSet& set = *w.singleWorkgroupSet;
   for (int d = 0; d < dispatches; ++d) {
     const SingleWorkgroupPush push{n_,    m_,    w.k, static_cast<std::uint32_t>(count), cap, w.budget,
@@ -849,7 +849,7 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
   return recordedOnce(slot, context_, [&](Sequence& s) {
-    const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+    const int largest = withinSolverLimit(kMaxInnerIterations);
     // Every solve counts into kLargestSolve but a long first one, whose poor warm start says
     // nothing about the ones that follow.
     for (int i = 0; i < count; ++i) {
@@ -1023,7 +1023,7 @@ compute::AdmmMeasures AdmmKernels::measure() {
   w.state.download(state);
   s.linearIterations = static_cast<long>(state[kInnerIterations]);
   s.inexactSolves = static_cast<long>(state[kCappedSolves]);
-  const int largest = std::min(kMaxInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+  const int largest = withinSolverLimit(kMaxInnerIterations);
   if (!w.singleWorkgroup && s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
     innerIterations_ = std::min(2 * innerIterations_, largest);
     w.blocks.clear();  // re-recorded with the new cap on their next use
@@ -1100,7 +1100,7 @@ void AdmmKernels::recordPolish() {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
   Workspace::Polish& p = *w.polish;
-  const int cap = std::min(kPolishInnerIterations, std::max(1, settings_.linearSolver.maxIterations));
+  const int cap = withinSolverLimit(kPolishInnerIterations);
   p.save.begin();
   la.copy(p.save, w.x, p.x0);
   la.copy(p.save, w.y, p.y0);

@@ -43,6 +43,7 @@
 // dispatches the last block needed, and a block that needs more runs a resume recording (the
 // host reads the kernel's small state after each run to know). Its inner solve stops at the
 // tolerance or at kMaxInnerIterations.
+#include <algorithm>
 #include <map>
 #include <memory>
 
@@ -181,6 +182,10 @@ class AdmmKernels final : public compute::AdmmKernels {
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
+  /// A recorded PCG iteration count, at most the linear solver's maxIterations (and at least 1).
+  int withinSolverLimit(int iterations) const {
+    return std::min(iterations, std::max(1, settings_.linearSolver.maxIterations));
+  }
   void prepare(std::uint32_t k);
   Sequence& block(int count, bool longFirstSolve);
   /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
