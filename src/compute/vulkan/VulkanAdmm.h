@@ -159,6 +159,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   int innerIterationCap() const { return innerIterations_; }
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
+  /// Levels of the multigrid's cycle (1: the coarsest level's dense inverse alone, an exact
+  /// preconditioner); 0 without a multigrid.
+  int multigridLevels() const { return multigrid_ ? aggregation_->levelCount() : 0; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
   void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) override;
   /// On the device: K_A is assembled as K (the active flags as K1's row scales), each
