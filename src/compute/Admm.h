@@ -35,8 +35,8 @@ enum class AdmmPreconditioner {
   /// (BlockMultigridSettings::coarsestBlocks), where the cycle has coarse levels at all,
   /// and its coarsening does not stall on a large coarsest level; block-Jacobi otherwise
   /// (small problems, whose many cheap iterations cost less) and in a single-workgroup
-  /// recording. A K whose blocks fit the cycle's dense coarsest level (vk::AdmmKernels::
-  /// kMaxCoarsestBlocks) keeps that level alone: its inverse, an exact preconditioner.
+  /// recording. A K of few blocks (vk::AdmmKernels::kMaxWholeInverseBlocks) keeps the
+  /// cycle's dense coarsest level alone: K's inverse, an exact preconditioner.
   Automatic,
 };
 

@@ -53,7 +53,7 @@ struct GlobalStepSettings {
   /// The QP's settings. On an iterative backend the inner solves with K of more than 64
   /// faces use the aggregation multigrid over faces (compute/BlockMultigrid.h): several
   /// times fewer PCG iterations than face blocks, and the host's ADMM iteration kept where
-  /// those drift. Up to 256 faces the multigrid is K's dense inverse alone (one PCG
+  /// those drift. Up to 128 faces the multigrid is K's dense inverse alone (one PCG
   /// iteration per solve).
   BoxQpSettings qp = [] {
     BoxQpSettings s;

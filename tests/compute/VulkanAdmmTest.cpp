@@ -1201,11 +1201,11 @@ TEST_F(VulkanAdmm, AutomaticPreconditionerIsMultigridAboveTheCoarsestLevelOnly) 
 }
 
 TEST_F(VulkanAdmm, AutomaticMultigridInvertsAKSmallEnoughWholeAndSolvesInAboutOnePcgIterationPerSolve) {
-  // 144 faces: more than the cycle's coarsest target (64 blocks), few enough for the dense
-  // coarsest inverse (256): Automatic keeps that level alone, an exact preconditioner. An
-  // explicit Multigrid coarsens to two levels (its test above: 30 ADMM, ~2 600 PCG).
+  // 100 faces: more than the cycle's coarsest target (64 blocks), few enough to invert K
+  // whole (kMaxWholeInverseBlocks): Automatic keeps that level alone, an exact
+  // preconditioner. An explicit Multigrid coarsens to two levels.
   RecordingBackend recorder;
-  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(10, recorder));
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
   ASSERT_EQ(settings.preconditioner, compute::AdmmPreconditioner::Automatic);

@@ -402,13 +402,16 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // Without it every face stayed alone, the multigrid was dropped, and the cube's
     // 384-face PQ level ran block-Jacobi solves of ~360 PCG iterations each.
     const compute::SparseMatrix CtC = aggregationCouplings(C_);
-    // Automatic, and K small enough for the coarsest level's dense inverse: that level alone,
-    // an exact preconditioner (one PCG iteration per solve). A V-cycle over 4-face
-    // aggregates is far weaker there: the cube's 96-face PQ level took ~100 PCG iterations
-    // per solve with it (307 s on lavapipe) against one (48 s).
+    // Automatic, and K small enough: its dense inverse alone, an exact preconditioner (one
+    // PCG iteration per solve). A V-cycle over 4-face aggregates is far weaker there: the
+    // cube's 96-face PQ level took ~100 PCG iterations per solve with it (307 s on
+    // lavapipe) against one (48 s). Not up to the coarsest level's limit: the inversion at
+    // each rho update is cubic in K's rows, and at 256 faces (1 024 rows) it cost more than
+    // the iterations it saved (a deformation's global step, 30 ADMM iterations: 104 s with
+    // 60 PCG iterations, 21.8 s with the two-level cycle's 3 961).
     compute::BlockMultigridSettings aggregationSettings = multigridSettings;
     if (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
-        static_cast<Index>(n_ / block_) <= kMaxCoarsestBlocks) {
+        static_cast<Index>(n_ / block_) <= kMaxWholeInverseBlocks) {
       aggregationSettings.coarsestBlocks = kMaxCoarsestBlocks;
     }
     aggregation_ = std::make_unique<compute::BlockAggregation>(compute::SparseMatrix(K0_ + CtC), aggregationSettings);

@@ -110,6 +110,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// 64: coarsening that stalls above this falls back to, or with an explicit choice
   /// refuses for, block-Jacobi).
   static constexpr Index kMaxCoarsestBlocks = 256;
+  /// Automatic preconditioning of a K with at most this many blocks (and more than the
+  /// cycle's coarsest target) inverts K whole, the cycle's coarsest level alone.
+  static constexpr Index kMaxWholeInverseBlocks = 128;
 
   /// Upload P (n x n), C (m x n) and C^T. Throws Error(Device) when a buffer exceeds the device.
   /// `unitsPerDispatch` > 0 overrides the single-workgroup kernel's work per dispatch
@@ -159,8 +162,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   int innerIterationCap() const { return innerIterations_; }
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
-  /// Levels of the multigrid's cycle (1: the coarsest level's dense inverse alone, an exact
-  /// preconditioner); 0 without a multigrid.
+  /// Levels of the multigrid's cycle (1: K's dense inverse alone, an exact preconditioner:
+  /// kMaxWholeInverseBlocks); 0 without a multigrid.
   int multigridLevels() const { return multigrid_ ? aggregation_->levelCount() : 0; }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
   void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) override;
