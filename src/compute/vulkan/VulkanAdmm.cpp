@@ -211,12 +211,10 @@ Array<std::int32_t> uploaded(Context& context, const std::vector<std::int32_t>& 
 
 /// C^T C for the multigrid's aggregation: of C's values, or of its pattern (unit entries)
 /// where every value is zero (C given by its pattern, its values still to come).
-compute::SparseMatrix aggregationCouplings(const compute::SparseMatrix& C) {
-  const compute::SparseMatrix Ct = C.transpose();
+compute::SparseMatrix aggregationCouplings(const compute::SparseMatrix& C, const compute::SparseMatrix& Ct) {
   const bool valued = std::any_of(C.valuePtr(), C.valuePtr() + C.nonZeros(), [](double v) { return v != 0.0; });
   if (valued) return compute::SparseMatrix(Ct * C);
-  compute::SparseMatrix unit = C;
-  std::fill(unit.valuePtr(), unit.valuePtr() + unit.nonZeros(), 1.0);
+  const compute::SparseMatrix unit = C.unaryExpr([](double) { return 1.0; });
   return compute::SparseMatrix(compute::SparseMatrix(unit.transpose()) * unit);
 }
 
@@ -401,7 +399,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // setConstraintScaling) couples nothing yet; its pattern with unit entries stands in.
     // Without it every face stayed alone, the multigrid was dropped, and the cube's
     // 384-face PQ level ran block-Jacobi solves of ~360 PCG iterations each.
-    const compute::SparseMatrix CtC = aggregationCouplings(C_);
+    const compute::SparseMatrix CtC = aggregationCouplings(C_, Ct_);
     // Automatic, and K small enough: its dense inverse alone, an exact preconditioner (one
     // PCG iteration per solve). A V-cycle over 4-face aggregates is far weaker there: the
     // cube's 96-face PQ level took ~100 PCG iterations per solve with it (307 s on
