@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "compute/SparsePattern.h"
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
@@ -244,6 +245,10 @@ struct AdmmKernels::Workspace {
         w(context, m, k, "ADMM rho z - y"),
         Cx(context, m, k, "ADMM C x"),
         dy(context, m, k, "ADMM dy"),
+        xSaved(context, n, k, "ADMM x at the block's start"),
+        xTildeSaved(context, n, k, "ADMM xTilde at the block's start"),
+        ySaved(context, m, k, "ADMM y at the block's start"),
+        zSaved(context, m, k, "ADMM z at the block's start"),
         centre(context, m, k, "ADMM bound centres"),
         relaxed(context, std::max<std::uint32_t>(m, 1), MemoryClass::Device, "ADMM relaxed rows"),
         violation(context, m, k, "ADMM bound violation"),
@@ -264,6 +269,12 @@ struct AdmmKernels::Workspace {
   std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
+  /// The iterate at the start of the last multi-dispatch block, which measure() runs again
+  /// from there when one of its solves stopped at a cap below the largest (redoBlock).
+  DeviceVectors xSaved, xTildeSaved, ySaved, zSaved;
+  std::unique_ptr<Sequence> restore;  ///< x, xTilde, y, z from the saved ones (recorded on first use).
+  int lastBlockCount = 0;             ///< Iterations of the block that measure() may run again (0: none).
+  bool lastBlockLong = false;         ///< Whether that block's first solve was a long one.
   DeviceVectors centre;            ///< m x k: a relaxed start's (startRelaxed).
   Array<std::uint32_t> relaxed;    ///< m flags: a relaxed start's.
   DeviceVectors violation;         ///< m x k: boundViolation's scratch.
@@ -460,6 +471,7 @@ void AdmmKernels::setRho(const std::vector<char>& equality, double rho) {
   }
   assembleK(rho);
   longFirstSolve_ = true;
+  if (workspace_) workspace_->lastBlockCount = 0;  // a block from before K changed is not run again
   // The solves after a new rho are harder than those a shrunk cap was sized by.
   if (innerIterations_ < kInitialInnerIterations) {
     innerIterations_ = withinSolverLimit(kInitialInnerIterations);
@@ -874,6 +886,11 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
   return recordedOnce(slot, context_, [&](Sequence& s) {
+    LinearAlgebra& la = algebra_;
+    la.copy(s, w.x, w.xSaved);
+    la.copy(s, w.xTilde, w.xTildeSaved);
+    la.copy(s, w.y, w.ySaved);
+    la.copy(s, w.z, w.zSaved);
     const int largest = withinSolverLimit(kMaxInnerIterations);
     // Every solve counts into kLargestSolve but a long first one, whose poor warm start says
     // nothing about the ones that follow.
@@ -1018,14 +1035,50 @@ void AdmmKernels::iterate(int count) {
     return;
   }
   block(count, longFirstSolve_).run();
+  workspace_->lastBlockCount = count;
+  workspace_->lastBlockLong = longFirstSolve_;
   longFirstSolve_ = false;
+}
+
+void AdmmKernels::redoBlock() {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  recordedOnce(w.restore, context_, [&](Sequence& s) {
+    la.copy(s, w.xSaved, w.x);
+    la.copy(s, w.xTildeSaved, w.xTilde);
+    la.copy(s, w.ySaved, w.y);
+    la.copy(s, w.zSaved, w.z);
+  }).run();
+  const double capped = static_cast<double>(cappedSolves_);  // the discarded block's capped solves do not count
+  w.state.upload({&capped, 1}, kCappedSolves);
+  block(w.lastBlockCount, w.lastBlockLong).run();
 }
 
 compute::AdmmMeasures AdmmKernels::measure() {
   compute::AdmmMeasures s;
   if (!workspace_) return s;
   Workspace& w = *workspace_;
+  const int largest = withinSolverLimit(kMaxInnerIterations);
+  double state[kStateSize];
   w.check.run();
+  w.state.download(state);
+  // A block with a solve stopped by a cap below the largest runs again from its start with
+  // the cap doubled: its inexact steps would have changed the ADMM's path (on a 324-face
+  // exact global step 40 ADMM iterations and 4 rho updates against the host's 30 and 3).
+  // Only a solve capped at the largest cap makes an inexact step.
+  const int redoCount = std::exchange(w.lastBlockCount, 0);
+  while (redoCount > 0 && !w.singleWorkgroup && static_cast<long>(state[kCappedSolves]) > cappedSolves_ &&
+         innerIterations_ < largest) {
+    throwIfCancelled("the ADMM iteration");
+    innerIterations_ = std::min(2 * innerIterations_, largest);
+    w.blocks.clear();  // re-recorded with the new cap
+    w.lastBlockCount = redoCount;
+    redoBlock();
+    w.lastBlockCount = 0;
+    ++redoneBlocks_;
+    w.check.run();
+    w.state.download(state);
+  }
   const std::vector<double> all = w.measures.read();
   auto slot = [&](std::uint32_t index) {
     Eigen::VectorXd v(w.k);
@@ -1044,11 +1097,8 @@ compute::AdmmMeasures AdmmKernels::measure() {
   s.dy = slot(kDy);
   s.Ctdy = slot(kCtdy);
   s.support = slot(kSupport);
-  double state[kStateSize];
-  w.state.download(state);
   s.linearIterations = static_cast<long>(state[kInnerIterations]);
   s.inexactSolves = static_cast<long>(state[kCappedSolves]);
-  const int largest = withinSolverLimit(kMaxInnerIterations);
   if (!w.singleWorkgroup && s.inexactSolves > cappedSolves_ && innerIterations_ < largest) {
     innerIterations_ = std::min(2 * innerIterations_, largest);
     w.blocks.clear();  // re-recorded with the new cap on their next use

@@ -27,10 +27,12 @@
 // every column has r.z <= tol^2 b.z and ||r|| below the host's bound from the ADMM
 // residuals (AdmmSettings::linearToleranceFraction), the remaining recorded iterations are
 // empty dispatches. So each solve stops at the tolerance, like a host-driven PCG, without a
-// read-back. A solve that needs more than the cap continues from its warm start in the
-// next ADMM iteration (an inexact ADMM step, counted in AdmmInfo::inexactSolves); when a
-// check sees one, the cap doubles for the following blocks (re-recorded), up to
-// kMaxInnerIterations; when the solves since the start are short, it shrinks
+// read-back. When a check sees a solve that needed more than the cap, the cap doubles
+// (re-recorded), up to kMaxInnerIterations, and the block runs again from the iterate it
+// started at (saved by the block on the device): a capped solve's inexact step changes the
+// ADMM's path, and the host's exact solves take none. Only a solve capped at
+// kMaxInnerIterations continues from its warm start in the next ADMM iteration (an
+// inexact step, counted in AdmmInfo::inexactSolves). When the solves since the start are short, it shrinks
 // (kMinInnerIterations), and a rho update restores at least kInitialInnerIterations. The first iteration after start() or a rho update, whose warm
 // start is the poorest, always gets kMaxInnerIterations. A fixed count without the flag would either waste work or stop
 // short on every solve.
@@ -160,6 +162,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   bool singleWorkgroup() const;
   /// PCG iterations recorded per ADMM iteration in the current blocks (the cap above).
   int innerIterationCap() const { return innerIterations_; }
+  /// Blocks that measure() ran again with a doubled cap since these kernels were made.
+  long redoneBlocks() const { return redoneBlocks_; }
   /// Whether the inner PCG is preconditioned by the multigrid V-cycle (else block-Jacobi).
   bool multigrid() const { return multigrid_ != nullptr; }
   /// Levels of the multigrid's cycle (1: K's dense inverse alone, an exact preconditioner:
@@ -193,7 +197,10 @@ class AdmmKernels final : public compute::AdmmKernels {
     return std::min(iterations, std::max(1, settings_.linearSolver.maxIterations));
   }
   void prepare(std::uint32_t k);
+  /// `count` iterations, after saving the iterate they start from (Workspace::xSaved ...).
   Sequence& block(int count, bool longFirstSolve);
+  /// The last block again from its saved start, with the current cap.
+  void redoBlock();
   /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
   /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
   void assembleK1(const std::vector<double>& rowScales);
@@ -290,6 +297,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
   long cappedSolves_ = 0;            ///< Capped solves seen at the last check.
+  long redoneBlocks_ = 0;
   bool longFirstSolve_ = true;       ///< The next block starts after start() or setRho().
   double linearTolerance_ = 0.0;     ///< Bound on each column's ||r|| of the inner solves.
   std::unique_ptr<Workspace> workspace_;
