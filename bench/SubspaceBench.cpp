@@ -19,6 +19,7 @@
 #include "subspace/Eigenshapes.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/MeshLaplacian.h"
+#include "subspace/SparseShapes.h"
 #include "subspace/SubspaceDeformation.h"
 
 namespace {
@@ -66,6 +67,24 @@ void BM_Eigenshapes(benchmark::State& state, SpaceKind kind) {
   }
   state.counters["faces"] = mesh.faceCount();
   state.counters["dimension"] = space.N.dimension();
+}
+
+/// One sparse shape (OMP, linear-spaces paper §3) seeded at the grid's middle vertex moving
+/// along z, up to the default 64 moving vertices; B is built outside the timed loop.
+void BM_SparseShape(benchmark::State& state, SpaceKind kind) {
+  const PolygonMesh mesh = gridOfFaces(state.range(0));
+  const ConstraintMatrix B = buildConstraintMatrix(mesh, uniformAssignment(kind, mesh.faceCount()));
+  const Index side = static_cast<Index>(std::lround(std::sqrt(static_cast<double>(mesh.faceCount()))));
+  const Index middle = (side / 2) * (side + 1) + side / 2;
+  SparseShapeInfo info;
+  for (auto _ : state) {
+    const Positions X = sparseShape(B, middle, Eigen::Vector3d::UnitZ(), {}, &info);
+    benchmark::DoNotOptimize(X.data());
+  }
+  state.counters["faces"] = mesh.faceCount();
+  state.counters["omp_steps"] = static_cast<double>(info.iterations);
+  state.counters["moving_vertices"] = static_cast<double>(info.supportVertices);
+  state.counters["residual"] = info.residual;
 }
 
 /// One local/global iteration, after the precomputation (which is reported separately
@@ -168,6 +187,11 @@ BENCHMARK_CAPTURE(BM_NullSpaceBasis, vertical, SpaceKind::Vertical)
 
 BENCHMARK_CAPTURE(BM_Eigenshapes, affine, SpaceKind::Affine)->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Eigenshapes, parallel, SpaceKind::Parallel)->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_CAPTURE(BM_SparseShape, affine, SpaceKind::Affine)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SparseShape, affine, SpaceKind::Affine)
+    ->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_SparseShape, vertical, SpaceKind::Vertical)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_CAPTURE(BM_DeformationPrecompute, affine, SpaceKind::Affine)
     ->Arg(1024)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);

@@ -14,13 +14,26 @@ Index ConstraintMatrix::equationCount() const {
 
 compute::SparseMatrix ConstraintMatrix::fullMatrix() const {
   if (!separable) return matrix;
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(matrix.nonZeros()) * 3);
-  for (int r = 0; r < matrix.outerSize(); ++r)
-    for (compute::SparseMatrix::InnerIterator it(matrix, r); it; ++it)
-      for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * r + c, 3 * it.col() + c, it.value());
-  compute::SparseMatrix full(matrix.rows() * 3, matrix.cols() * 3);
-  full.setFromTriplets(triplets.begin(), triplets.end());
+  // B = B1 (x) I3: row 3 r + c holds row r's entries at columns 3 j + c, still sorted, so the
+  // compressed rows are written directly.
+  const Eigen::Index rows = matrix.rows() * 3;
+  compute::SparseMatrix full(rows, matrix.cols() * 3);
+  full.resizeNonZeros(matrix.nonZeros() * 3);
+  int* outer = full.outerIndexPtr();
+  int* inner = full.innerIndexPtr();
+  double* values = full.valuePtr();
+  int next = 0;
+  outer[0] = 0;
+  for (int r = 0; r < matrix.outerSize(); ++r) {
+    for (int c = 0; c < 3; ++c) {
+      for (compute::SparseMatrix::InnerIterator it(matrix, r); it; ++it) {
+        inner[next] = 3 * static_cast<int>(it.col()) + c;
+        values[next] = it.value();
+        ++next;
+      }
+      outer[3 * r + c + 1] = next;
+    }
+  }
   return full;
 }
 

@@ -115,6 +115,24 @@ TEST(LinearSpace, AffineSpaceOfARealClosedMeshContainsTheGlobalAffineMotions) {
   EXPECT_LE((affine - N1 * (N1.transpose() * affine)).norm(), 1e-9 * affine.norm());
 }
 
+TEST(LinearSpace, FullMatrixOfASeparableSpaceActsOnEveryCoordinateAsItsOneCoordinateMatrix) {
+  for (const NamedMesh& family : meshFamilies()) {
+    SCOPED_TRACE(family.name);
+    const ConstraintMatrix B = buildConstraintMatrix(family.mesh, uniformAssignment(SpaceKind::Affine, family.mesh.faceCount()));
+    ASSERT_TRUE(B.separable);
+    const compute::SparseMatrix full = B.fullMatrix();
+    ASSERT_EQ(full.rows(), 3 * B.matrix.rows());
+    ASSERT_EQ(full.cols(), 3 * B.matrix.cols());
+    EXPECT_EQ(full.nonZeros(), 3 * B.matrix.nonZeros());
+    const Positions X = Positions::Random(family.mesh.vertexCount(), 3);
+    const Eigen::Map<const Eigen::VectorXd> x(X.data(), X.size());  // (x0, y0, z0, x1, ...)
+    const Eigen::VectorXd product = full * x;
+    const Eigen::MatrixXd perCoordinate = B.matrix * X;
+    for (Eigen::Index r = 0; r < B.matrix.rows(); ++r)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(product[3 * r + c], perCoordinate(r, c), 1e-12);
+  }
+}
+
 TEST(LinearSpace, DimensionIsNeverBelowTheLowerBound) {
   for (const auto& [name, mesh] : meshFamilies()) {
     for (SpaceKind kind : {SpaceKind::Affine, SpaceKind::Parallel, SpaceKind::Vertical}) {
