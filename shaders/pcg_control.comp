@@ -10,7 +10,10 @@
 // done flag of this solve, [1] iterations run, [2] solves stopped by the recorded cap,
 // [3] abs^2, an absolute bound the host derives from the ADMM's residuals (compute/Admm.h),
 // [STATE_SOLVE_START] [1] when this solve began, [STATE_LARGEST] the most iterations a
-// counted solve ran since the ADMM's start (the host sizes the next blocks' recordings by it).
+// counted solve ran since the ADMM's start (the host sizes the next blocks' recordings by it),
+// [STATE_BLOCK_CAPPED] [2] when the current ADMM block began. A block recorded with a cap the
+// host would raise and run again after a capped solve (vk::AdmmKernels::measure) skips the
+// solves after one: their iterates are discarded, so only their PCG iterations would be lost.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
@@ -19,6 +22,7 @@ layout(local_size_x = 1) in;
 // vk::AdmmKernels' State slots kSolveStart and kLargestSolve.
 #define STATE_SOLVE_START 20
 #define STATE_LARGEST 21
+#define STATE_BLOCK_CAPPED 22
 
 layout(std430, binding = 0) readonly buffer Scalars { double scalars[]; };
 layout(std430, binding = 1) buffer State { double state[]; };
@@ -35,12 +39,16 @@ layout(push_constant) uniform Push {
   uint countLargest;  // 1: this solve counts into STATE_LARGEST
   double tolerance2;
   double floor2;
+  uint blockStart;       // 1: the first solve of an ADMM block (sets STATE_BLOCK_CAPPED)
+  uint abandonAfterCap;  // 1: skip this solve when one since the block's start was capped
 } pc;
 
 void main() {
   if (pc.mode == 0) {
     state[0] = 0.0;
     state[STATE_SOLVE_START] = state[1];
+    if (pc.blockStart != 0u) state[STATE_BLOCK_CAPPED] = state[2];
+    if (pc.abandonAfterCap != 0u && state[2] > state[STATE_BLOCK_CAPPED]) state[0] = 1.0;
   }
   bool running = state[0] == 0.0;
   if (running) {

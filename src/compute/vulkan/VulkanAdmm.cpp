@@ -20,6 +20,7 @@ namespace {
 struct ControlPush {
   std::uint32_t m, slotRz, slotBz, mode, groupsColumn, groupsDirection, slotFloor, countLargest;
   double tolerance2, floor2;
+  std::uint32_t blockStart, abandonAfterCap;
 };
 constexpr std::uint32_t kNoFloor = ~0u;
 struct RhsPush {
@@ -68,9 +69,11 @@ enum State : std::uint32_t {
   kStateEpsilon = kStateRr + AdmmKernels::kSingleWorkgroupColumns,  ///< A relaxed start's (admm_relaxed_bounds)
   kSolveStart,    ///< pcg_control: kInnerIterations when the current solve began
   kLargestSolve,  ///< pcg_control: the most iterations a counted solve ran since start()
+  kBlockCapped,   ///< pcg_control: kCappedSolves when the current block began
   kStateSize
 };
-static_assert(kSolveStart == 20 && kLargestSolve == 21, "shaders/pcg_control.comp's STATE_SOLVE_START, STATE_LARGEST");
+static_assert(kSolveStart == 20 && kLargestSolve == 21 && kBlockCapped == 22,
+              "shaders/pcg_control.comp's STATE_SOLVE_START, STATE_LARGEST, STATE_BLOCK_CAPPED");
 // llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
 // single-workgroup kernel's budget keeps its estimate below half of that.
 constexpr std::uint64_t kCpuLoopBackEdges = 32768;
@@ -773,7 +776,7 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
 }
 
 void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd,
-                                   bool countLargest) {
+                                   bool countLargest, BlockPosition position) {
   Workspace& w = *workspace_;
   const std::uint32_t k = w.k;
   const std::uint32_t nk = n_ * k;
@@ -791,9 +794,11 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   const std::uint32_t floorSlot = target == SolveTarget::RightHandSide ? kNoFloor : kRhsBz;
   const double floor2 = kPolishRoundingFloor * kPolishRoundingFloor;
   auto control = [&](std::uint32_t mode, std::uint32_t slotRz) {
+    const bool first = mode == 0 && position.first;
+    const bool abandon = mode == 0 && position.abandonAfterCap;
     s.dispatch(control_, *w.controlSet,
                ControlPush{k, slotRz, kBz, mode, groups, directionGroups, floorSlot, countLargest ? 1u : 0u,
-                           tolerance2, floor2},
+                           tolerance2, floor2, first ? 1u : 0u, abandon ? 1u : 0u},
                1);
     s.barrier();
   };
@@ -825,13 +830,14 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   }
 }
 
-void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest) {
+void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest,
+                                  BlockPosition position) {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
   const std::uint32_t mk = m_ * w.k;
 
   recordRightHandSide(s);
-  recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, false, countLargest);
+  recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, false, countLargest, position);
 
   // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
   const double alpha = settings_.relaxation;
@@ -892,11 +898,15 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
     la.copy(s, w.y, w.ySaved);
     la.copy(s, w.z, w.zSaved);
     const int largest = withinSolverLimit(kMaxInnerIterations);
+    // A capped solve makes measure() run this block again when its cap is below the largest
+    // (and the multi-dispatch recording's); the solves after it are then skipped.
+    const bool abandonAfterCap = !w.singleWorkgroup && innerIterations_ < largest;
     // Every solve counts into kLargestSolve but a long first one, whose poor warm start says
     // nothing about the ones that follow.
     for (int i = 0; i < count; ++i) {
       const bool longSolve = i == 0 && longFirstSolve;
-      recordIteration(s, i == count - 1, longSolve ? largest : innerIterations_, !longSolve);
+      recordIteration(s, i == count - 1, longSolve ? largest : innerIterations_, !longSolve,
+                      BlockPosition{i == 0, i > 0 && abandonAfterCap});
     }
   });
 }

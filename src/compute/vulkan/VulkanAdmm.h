@@ -30,7 +30,8 @@
 // read-back. When a check sees a solve that needed more than the cap, the cap doubles
 // (re-recorded), up to kMaxInnerIterations, and the block runs again from the iterate it
 // started at (saved by the block on the device): a capped solve's inexact step changes the
-// ADMM's path, and the host's exact solves take none. Only a solve capped at
+// ADMM's path, and the host's exact solves take none. The block's solves after a capped one
+// are skipped on the device (pcg_control), since their work would be discarded. Only a solve capped at
 // kMaxInnerIterations continues from its warm start in the next ADMM iteration (an
 // inexact step, counted in AdmmInfo::inexactSolves). When the solves since the start are short, it shrinks
 // (kMinInnerIterations), and a rho update restores at least kInitialInnerIterations. The first iteration after start() or a rho update, whose warm
@@ -241,10 +242,15 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// r = b - K xTilde, its preconditioned residual, the stopping target's b.z and, for the
   /// polish's solves, b's (the rounding floor's scale).
   void recordPcgStart(Sequence& s, SolveTarget target);
+  /// A solve's place in an ADMM block (block()).
+  struct BlockPosition {
+    bool first;            ///< The block's first solve: notes the capped solves so far.
+    bool abandonAfterCap;  ///< Skipped when a solve of the block before it was capped.
+  };
   /// `countLargest`: the solve's iterations count into the longest solve (kMinInnerIterations).
   void recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target = SolveTarget::RightHandSide,
-                        bool firstOdd = false, bool countLargest = false);
-  void recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest);
+                        bool firstOdd = false, bool countLargest = false, BlockPosition position = {});
+  void recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest, BlockPosition position);
   void recordPolish();
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);
   void iterateSingleWorkgroup(int count);
