@@ -40,11 +40,11 @@ struct CommandRegistration {
 /// Create the backend the user asked for, printing a fallback warning on stderr.
 std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options);
 
-/// For a command that computes on the CPU whatever the backend (subspace, sparse shapes:
-/// their factorizations have no device kernels): a warning on
-/// stderr, even with --quiet, when --backend vulkan asked for the device, so that nobody
-/// takes its results or timings for the device's. Returns the backend name for the report.
-std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command);
+/// For a command that computes on the CPU whatever the backend (subspace, sparse shapes, the
+/// dual alone; `reason` says why): a warning on stderr, even with --quiet, when --backend
+/// vulkan asked for the device, so that nobody takes its results or timings for the
+/// device's. Returns the backend name for the report.
+std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command, const std::string& reason);
 
 /// For a linear-space command whose heavy products run on the backend (`deviceWork`, e.g.
 /// "the reduced operator": the d x d matrix N^T S N of eigenshapes and fundamental shapes,

@@ -21,10 +21,10 @@ std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options) {
   return backend;
 }
 
-std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command) {
+std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& command, const std::string& reason) {
   if (options.backend == "vulkan") {
-    std::cerr << "warning: plano " << command
-              << " computes on the CPU: the linear-space factorizations have no Vulkan kernels (--backend vulkan "
+    std::cerr << "warning: plano " << command << " computes on the CPU: " << reason
+              << " (--backend vulkan "
                  "applies to subdivide, planarize, prescribe, interpolate and deform, to the reduced operators "
                  "of explore, dual --primal and shapes --kind fundamental, and to embed)"
               << std::endl;

@@ -46,8 +46,9 @@ RunFunction setup(CLI::App& app) {
     // The dual alone is geometry on the CPU; exploring it forms a reduced operator on the backend.
     std::unique_ptr<compute::Backend> backend;
     const std::string backendName =
-        o->primal.empty() ? warnComputesOnCpu(global, "dual")
-                          : (backend = makeLinearSpaceBackend(global, "dual", "the reduced operator runs"))->name();
+        o->primal.empty()
+            ? warnComputesOnCpu(global, "dual", "the polar dual alone is a per-face construction without a solve")
+            : (backend = makeLinearSpaceBackend(global, "dual", "the reduced operator runs"))->name();
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);

@@ -55,10 +55,13 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
   return [o](const GlobalOptions& global) {
-    // Sparse shapes (OMP on B) compute on the CPU; a fundamental shape's reduced operator
-    // runs on the backend.
+    // Sparse shapes (OMP on B) compute on the CPU: each step works on the few hundred rows
+    // around its support. A fundamental shape's reduced operator runs on the backend.
     std::unique_ptr<compute::Backend> backend;
-    const std::string backendName = o->kind == "sparse" ? warnComputesOnCpu(global, "shapes --kind sparse")
+    const std::string backendName = o->kind == "sparse"
+                                        ? warnComputesOnCpu(global, "shapes --kind sparse",
+                                                            "each OMP step works on the few hundred rows around its "
+                                                            "support, too little work for a device")
                                                         : (backend = makeLinearSpaceBackend(global, "shapes", "the reduced operator runs"))->name();
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);

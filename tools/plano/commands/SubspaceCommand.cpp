@@ -45,7 +45,8 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--rank-tolerance", o->rankTolerance, "Relative rank tolerance of B")->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   return [o](const GlobalOptions& global) {
-    const std::string backend = warnComputesOnCpu(global, "subspace");
+    const std::string backend =
+        warnComputesOnCpu(global, "subspace", "its factorizations of B (SPQR, dense SVD) have no Vulkan kernels");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     LinearSpaceSettings settings;
