@@ -1462,9 +1462,10 @@ TEST_F(VulkanAdmm, ABlockWithACappedSolveRunsAgainWithADoubledCapAndKeepsTheHost
   // 324 faces, the exact (eps = 0) attempt's QP, three multigrid levels. Some inner solves
   // need more than the cap the blocks were recorded with; kept, their inexact steps took the
   // device 40 ADMM iterations and 4 rho updates against the host's 30 and 3 (x 9.9e-6 from
-  // the host's). Run again from the block's saved start with the cap doubled, the device
-  // takes the host's path. The block's solves after the capped one are skipped: measured
-  // 6 281 PCG iterations in all, 8 329 when they ran.
+  // the host's). Run again with the cap doubled, from the saved start of the capped
+  // iteration, the device takes the host's path (x 4.5e-6 from the host's). The block's
+  // solves after the capped one are skipped: measured 5 794 PCG iterations in all, 6 281
+  // when the whole block ran again, 8 329 when the solves after the capped one also ran.
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(18, recorder));
   const compute::AdmmSettings settings = recorder.settingsUsed;
@@ -1486,7 +1487,8 @@ TEST_F(VulkanAdmm, ABlockWithACappedSolveRunsAgainWithADoubledCapAndKeepsTheHost
   EXPECT_EQ(device.info.factorizations, host.info.factorizations);
   EXPECT_EQ(device.info.inexactSolves, 0);
   EXPECT_LT(relativeDifference(device.x, host.x), 1e-5);
-  EXPECT_LT(device.info.linearIterations, 7300) << "the solves after a capped one ran";
+  EXPECT_LT(device.info.linearIterations, 6100)
+      << "the block ran again from its start, or its solves after a capped one ran";
 }
 
 }  // namespace

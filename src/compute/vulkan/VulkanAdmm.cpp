@@ -34,6 +34,9 @@ struct UpdatePush {
 struct SupportPush {
   std::uint32_t n;
 };
+struct SaveIteratePush {  // admm_save_iterate
+  std::uint32_t nk, mk, iteration, always;
+};
 struct RelaxedBoundsPush {
   std::uint32_t rows, count, epsilonSlot;
 };
@@ -70,10 +73,12 @@ enum State : std::uint32_t {
   kSolveStart,    ///< pcg_control: kInnerIterations when the current solve began
   kLargestSolve,  ///< pcg_control: the most iterations a counted solve ran since start()
   kBlockCapped,   ///< pcg_control: kCappedSolves when the current block began
+  kSavedIteration,  ///< admm_save_iterate: the iteration of the block whose start is saved
   kStateSize
 };
-static_assert(kSolveStart == 20 && kLargestSolve == 21 && kBlockCapped == 22,
-              "shaders/pcg_control.comp's STATE_SOLVE_START, STATE_LARGEST, STATE_BLOCK_CAPPED");
+static_assert(kSolveStart == 20 && kLargestSolve == 21 && kBlockCapped == 22 && kSavedIteration == 23,
+              "shaders/pcg_control.comp's STATE_SOLVE_START, STATE_LARGEST, STATE_BLOCK_CAPPED and "
+              "admm_save_iterate.comp's STATE_SAVED_ITERATION");
 // llvmpipe ends all loops of an invocation after 65535 back-edges in total; the
 // single-workgroup kernel's budget keeps its estimate below half of that.
 constexpr std::uint64_t kCpuLoopBackEdges = 32768;
@@ -248,10 +253,10 @@ struct AdmmKernels::Workspace {
         w(context, m, k, "ADMM rho z - y"),
         Cx(context, m, k, "ADMM C x"),
         dy(context, m, k, "ADMM dy"),
-        xSaved(context, n, k, "ADMM x at the block's start"),
-        xTildeSaved(context, n, k, "ADMM xTilde at the block's start"),
-        ySaved(context, m, k, "ADMM y at the block's start"),
-        zSaved(context, m, k, "ADMM z at the block's start"),
+        xSaved(context, n, k, "ADMM saved x"),
+        xTildeSaved(context, n, k, "ADMM saved xTilde"),
+        ySaved(context, m, k, "ADMM saved y"),
+        zSaved(context, m, k, "ADMM saved z"),
         centre(context, m, k, "ADMM bound centres"),
         relaxed(context, std::max<std::uint32_t>(m, 1), MemoryClass::Device, "ADMM relaxed rows"),
         violation(context, m, k, "ADMM bound violation"),
@@ -272,8 +277,9 @@ struct AdmmKernels::Workspace {
   std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
-  /// The iterate at the start of the last multi-dispatch block, which measure() runs again
-  /// from there when one of its solves stopped at a cap below the largest (redoBlock).
+  /// The iterate at the start of the last multi-dispatch block's first capped iteration (or of
+  /// its last iteration when none was capped), which measure() runs again from when that
+  /// solve stopped at a cap below the largest (redoBlock).
   DeviceVectors xSaved, xTildeSaved, ySaved, zSaved;
   std::unique_ptr<Sequence> restore;  ///< x, xTilde, y, z from the saved ones (recorded on first use).
   int lastBlockCount = 0;             ///< Iterations of the block that measure() may run again (0: none).
@@ -378,6 +384,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
       boundViolation_(context, "admm_bound_violation", 4, sizeof(CountPush)),
       negatedMaps_(context, "admm_negated_maps", 2, sizeof(NegatedMapsPush)),
       activeFlags_(context, "admm_active_flags", 2, sizeof(ActiveFlagsPush)),
+      saveIterate_(context, "admm_save_iterate", 9, sizeof(SaveIteratePush)),
       assembly_(context),
       innerIterations_(withinSolverLimit(kInitialInnerIterations)) {
   C_.makeCompressed();
@@ -892,18 +899,23 @@ Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
   return recordedOnce(slot, context_, [&](Sequence& s) {
-    LinearAlgebra& la = algebra_;
-    la.copy(s, w.x, w.xSaved);
-    la.copy(s, w.xTilde, w.xTildeSaved);
-    la.copy(s, w.y, w.ySaved);
-    la.copy(s, w.z, w.zSaved);
     const int largest = withinSolverLimit(kMaxInnerIterations);
-    // A capped solve makes measure() run this block again when its cap is below the largest
-    // (and the multi-dispatch recording's); the solves after it are then skipped.
+    // A capped solve makes measure() run this block again, from the iteration of that solve,
+    // when its cap is below the largest (and the multi-dispatch recording's); the solves
+    // after it are then skipped, and the iterations after it no longer save their start.
     const bool abandonAfterCap = !w.singleWorkgroup && innerIterations_ < largest;
+    const std::uint32_t nk = n_ * w.k, mk = m_ * w.k;
     // Every solve counts into kLargestSolve but a long first one, whose poor warm start says
     // nothing about the ones that follow.
     for (int i = 0; i < count; ++i) {
+      if (i == 0 || abandonAfterCap) {
+        s.dispatch(saveIterate_,
+                   {w.state, w.x.data(), w.xTilde.data(), w.y.data(), w.z.data(), w.xSaved.data(),
+                    w.xTildeSaved.data(), w.ySaved.data(), w.zSaved.data()},
+                   SaveIteratePush{nk, mk, static_cast<std::uint32_t>(i), i == 0 ? 1u : 0u},
+                   groupsFor(context_, std::max(nk, mk)));
+        s.barrier();
+      }
       const bool longSolve = i == 0 && longFirstSolve;
       recordIteration(s, i == count - 1, longSolve ? largest : innerIterations_, !longSolve,
                       BlockPosition{i == 0, i > 0 && abandonAfterCap});
@@ -1050,7 +1062,7 @@ void AdmmKernels::iterate(int count) {
   longFirstSolve_ = false;
 }
 
-void AdmmKernels::redoBlock() {
+void AdmmKernels::redoBlock(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
   LinearAlgebra& la = algebra_;
   recordedOnce(w.restore, context_, [&](Sequence& s) {
@@ -1059,9 +1071,11 @@ void AdmmKernels::redoBlock() {
     la.copy(s, w.ySaved, w.y);
     la.copy(s, w.zSaved, w.z);
   }).run();
-  const double capped = static_cast<double>(cappedSolves_);  // the discarded block's capped solves do not count
+  // The discarded iterations' capped solves do not count; the block's iterations before the
+  // saved one capped none.
+  const double capped = static_cast<double>(cappedSolves_);
   w.state.upload({&capped, 1}, kCappedSolves);
-  block(w.lastBlockCount, w.lastBlockLong).run();
+  block(count, longFirstSolve).run();
 }
 
 compute::AdmmMeasures AdmmKernels::measure() {
@@ -1072,19 +1086,22 @@ compute::AdmmMeasures AdmmKernels::measure() {
   double state[kStateSize];
   w.check.run();
   w.state.download(state);
-  // A block with a solve stopped by a cap below the largest runs again from its start with
-  // the cap doubled: its inexact steps would have changed the ADMM's path (on a 324-face
-  // exact global step 40 ADMM iterations and 4 rho updates against the host's 30 and 3).
-  // Only a solve capped at the largest cap makes an inexact step.
-  const int redoCount = std::exchange(w.lastBlockCount, 0);
-  while (redoCount > 0 && !w.singleWorkgroup && static_cast<long>(state[kCappedSolves]) > cappedSolves_ &&
+  // A block with a solve stopped by a cap below the largest runs again with the cap doubled:
+  // its inexact steps would have changed the ADMM's path (on a 324-face exact global step 40
+  // ADMM iterations and 4 rho updates against the host's 30 and 3). Only a solve capped at
+  // the largest cap makes an inexact step. The iterations before the capped one were exact
+  // and are kept: the block's remaining iterations run again from the capped one's saved start.
+  int remaining = std::exchange(w.lastBlockCount, 0);
+  bool longFirst = w.lastBlockLong;
+  while (remaining > 0 && !w.singleWorkgroup && static_cast<long>(state[kCappedSolves]) > cappedSolves_ &&
          innerIterations_ < largest) {
     throwIfCancelled("the ADMM iteration");
+    const int from = std::clamp(static_cast<int>(state[kSavedIteration]), 0, remaining - 1);
+    remaining -= from;
+    longFirst = longFirst && from == 0;
     innerIterations_ = std::min(2 * innerIterations_, largest);
     w.blocks.clear();  // re-recorded with the new cap
-    w.lastBlockCount = redoCount;
-    redoBlock();
-    w.lastBlockCount = 0;
+    redoBlock(remaining, longFirst);
     ++redoneBlocks_;
     w.check.run();
     w.state.download(state);

@@ -28,8 +28,9 @@
 // residuals (AdmmSettings::linearToleranceFraction), the remaining recorded iterations are
 // empty dispatches. So each solve stops at the tolerance, like a host-driven PCG, without a
 // read-back. When a check sees a solve that needed more than the cap, the cap doubles
-// (re-recorded), up to kMaxInnerIterations, and the block runs again from the iterate it
-// started at (saved by the block on the device): a capped solve's inexact step changes the
+// (re-recorded), up to kMaxInnerIterations, and the block's iterations from the capped one on
+// run again from the iterate that one started at (saved by the block on the device, each
+// iteration until a solve is capped): a capped solve's inexact step changes the
 // ADMM's path, and the host's exact solves take none. The block's solves after a capped one
 // are skipped on the device (pcg_control), since their work would be discarded. Only a solve capped at
 // kMaxInnerIterations continues from its warm start in the next ADMM iteration (an
@@ -198,10 +199,12 @@ class AdmmKernels final : public compute::AdmmKernels {
     return std::min(iterations, std::max(1, settings_.linearSolver.maxIterations));
   }
   void prepare(std::uint32_t k);
-  /// `count` iterations, after saving the iterate they start from (Workspace::xSaved ...).
+  /// `count` iterations, each saving the iterate it starts from (Workspace::xSaved ...)
+  /// while no solve of the block was capped (shaders/admm_save_iterate.comp).
   Sequence& block(int count, bool longFirstSolve);
-  /// The last block again from its saved start, with the current cap.
-  void redoBlock();
+  /// `count` iterations with the current cap, from the saved start of the last block's capped
+  /// iteration (its last `count`).
+  void redoBlock(int count, bool longFirstSolve);
   /// K1 = C^T diag(rowScales) C (and its coarse levels), then K = K0 + rho K1 with its
   /// preconditioner; assembleK throws Error(Numerical) for a block that is not positive definite.
   void assembleK1(const std::vector<double>& rowScales);
@@ -298,7 +301,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   AdmmRecording recording_;
   std::uint32_t unitsPerDispatch_;
   Pipeline spmvDot_, step_, direction_, reduce_, control_, rhs_, update_, support_, assemble_, singleWorkgroup_, dot_;
-  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_, negatedMaps_, activeFlags_;
+  Pipeline relaxedBounds_, activeSides_, polishTargets_, boundViolation_, negatedMaps_, activeFlags_, saveIterate_;
   const ResidentFaceMaps* residentMaps_ = nullptr;
   Sequence assembly_;
   int innerIterations_;              ///< The current cap.
