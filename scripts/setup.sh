@@ -15,6 +15,9 @@ PACKAGES=(
   # reference implementation makes the sparse factorizations 1.4-2.4x faster (README).
   # The serial build, so that it never competes with Plano's own threads.
   libopenblas0-serial
+  # The BLAS interface Plano calls itself (cblas.h, libblas.so) for the linear spaces' large
+  # dense products; at run time it resolves to the OpenBLAS above.
+  libblas-dev
 )
 
 missing=()

@@ -20,8 +20,10 @@ namespace plano::compute {
 /// Error(Usage) unless S is square, coordinates >= 1 and N has coordinates * S.rows() rows.
 void checkReducedOperatorInputs(const SparseMatrix& S, const Eigen::MatrixXd& N, int coordinates);
 
-/// R = N^T (S (x) I_k) N with Eigen (k = coordinates): (S (x) I_k) N column by column, each
-/// column viewed as a row-major #V x k matrix, then one dense product.
+/// R = N^T (S (x) I_k) N on the CPU (k = coordinates): (S (x) I_k) N with Eigen column by
+/// column, each column viewed as a row-major #V x k matrix, then one dense product, of its
+/// lower half only when S is symmetric (cpu/SymmetricProduct.h). Throws Interrupted on a
+/// cancellation request.
 Eigen::MatrixXd reducedOperatorReference(const SparseMatrix& S, const Eigen::MatrixXd& N, int coordinates);
 
 }  // namespace plano::compute

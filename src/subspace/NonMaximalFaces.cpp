@@ -12,16 +12,14 @@ std::vector<NonMaximalFace> findNonMaximalFaces(const LinearSpace& space, const 
     const Index k = mesh.faces.degree(f);
     if (k == 3) continue;
     const FaceFrame frame = fitFaceFrame(mesh.vertices, mesh.faces[f], f, settings.degeneracy);
-    std::vector<Index> coordinates;
-    for (Index v : mesh.faces[f])
-      for (int c = 0; c < 3; ++c) coordinates.push_back(3 * v + c);
-    const Eigen::MatrixXd rows = space.N.coordinateRows(coordinates);
+    // Gathered once per face: the rows of a column-major N are strided reads.
+    const Eigen::MatrixXd rows = space.N.storedRows(mesh.faces[f]);
     const FaceSpace current = space.B.effective[f];
     for (FaceSpace other : {FaceSpace::Affine, FaceSpace::Vertical, FaceSpace::Parallel}) {
       if (other == current) continue;
       if (other == FaceSpace::Vertical && isHorizontal(frame, settings.up, settings.horizontalTolerance)) continue;
       const Eigen::MatrixXd block = faceBlock(frame, other, settings.up);
-      const double violation = rows.cols() ? (block * rows).cwiseAbs().maxCoeff() : 0.0;
+      const double violation = rows.cols() ? space.N.timesVertexRows(block, rows).cwiseAbs().maxCoeff() : 0.0;
       if (violation <= tolerance) {
         found.push_back({f, current, other});
         break;

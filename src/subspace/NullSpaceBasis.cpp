@@ -43,6 +43,7 @@ Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance
   double maxColumn = 0.0;
   for (Eigen::Index j = 0; j < At.outerSize(); ++j) maxColumn = std::max(maxColumn, At.col(j).norm());
   qr.setPivotThreshold(tolerance * std::max(maxColumn, 1e-300));
+  qr.cholmodCommon()->print = 0;  // A failure is the Error below, not CHOLMOD's own lines.
   qr.compute(At);
   if (qr.info() != Eigen::Success) throwNumerical("sparse QR of the constraint matrix failed");
   rank = static_cast<Index>(qr.rank());
@@ -73,8 +74,6 @@ SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettin
     info->dimension = basis.dimension();
     const Eigen::MatrixXd& C = basis.columns();
     info->residual = C.cols() && B.matrix.rows() ? (B.matrix * C).cwiseAbs().maxCoeff() : 0.0;
-    info->orthogonality =
-        C.cols() ? (C.transpose() * C - Eigen::MatrixXd::Identity(C.cols(), C.cols())).cwiseAbs().maxCoeff() : 0.0;
   }
   return basis;
 }

@@ -33,7 +33,8 @@ struct BasisInfo {
   double rankTolerance = 0.0;              ///< The relative tolerance used (after noise adaptation).
   Index dimension = 0;                     ///< dim null(B) of the full space.
   double residual = 0.0;                   ///< max |B N| entry: how exactly the basis lies in null(B).
-  double orthogonality = 0.0;              ///< max |N^T N - I| entry.
+  // N's orthogonality is not measured here: max |N^T N - I| costs #V d^2, minutes on a
+  // space of ten thousand dimensions (SubspaceBasis::orthogonalityError, for tests).
 };
 
 /// Orthonormal basis of null(B). Throws Error(Numerical) when the factorization fails.

@@ -70,4 +70,35 @@ Eigen::MatrixXd SubspaceBasis::coordinateRows(std::span<const Index> coordinates
   return rows;
 }
 
+Eigen::MatrixXd SubspaceBasis::storedRows(std::span<const Index> vertices) const {
+  const Index perVertex = separable_ ? 1 : 3;
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(vertices.size()) * perVertex, columns_.cols());
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    rows.middleRows(static_cast<Eigen::Index>(i) * perVertex, perVertex) =
+        columns_.middleRows(vertices[i] * perVertex, perVertex);
+  return rows;
+}
+
+Eigen::MatrixXd SubspaceBasis::timesVertexRows(const Eigen::MatrixXd& M, const Eigen::MatrixXd& rows) const {
+  if (!separable_) return M * rows;
+  // Row 3 v + c of N is N1's row v on columns 3 a + c: per axis c, M's columns on that
+  // axis (every third) times N1's rows.
+  const Eigen::Index r = M.rows(), k = rows.rows(), d1 = rows.cols();
+  Eigen::MatrixXd out(r, 3 * d1);
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>> onAxis(M.data() + c * r, r, k,
+                                                                            Eigen::OuterStride<>(3 * r));
+    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> axisColumns(out.data() + c * r, r, d1,
+                                                                     Eigen::OuterStride<>(3 * r));
+    axisColumns.noalias() = onAxis * rows;
+  }
+  return out;
+}
+
+double SubspaceBasis::orthogonalityError() const {
+  if (columns_.cols() == 0) return 0.0;
+  const Eigen::MatrixXd gram = columns_.transpose() * columns_;
+  return (gram - Eigen::MatrixXd::Identity(gram.rows(), gram.cols())).cwiseAbs().maxCoeff();
+}
+
 }  // namespace plano::subspace

@@ -43,6 +43,16 @@ class SubspaceBasis {
   Eigen::MatrixXd compactReducedOperator(compute::Backend& backend, const compute::SparseMatrix& S) const;
   /// Rows of N for the full coordinates 3 v + c listed in `coordinates` (#coordinates x d).
   Eigen::MatrixXd coordinateRows(std::span<const Index> coordinates) const;
+  /// The stored columns' rows for `vertices`: N1's rows (k x d1) when separable, else N's
+  /// rows 3 v, 3 v + 1, 3 v + 2 of each vertex (3k x d).
+  Eigen::MatrixXd storedRows(std::span<const Index> vertices) const;
+  /// M coordinateRows(3 v_i + c, for each vertex i and axis c in turn), given `rows` =
+  /// storedRows(v) (M has 3k columns). For a separable basis per axis, without N's zeros:
+  /// a third of the work, and no 3k x d matrix to fill.
+  Eigen::MatrixXd timesVertexRows(const Eigen::MatrixXd& M, const Eigen::MatrixXd& rows) const;
+  /// max |N^T N - I| entry of the stored columns: how orthonormal the basis is. Costs
+  /// #V d^2 (a check for tests and diagnostics, not for every space built).
+  double orthogonalityError() const;
 
  private:
   Eigen::MatrixXd columns_;

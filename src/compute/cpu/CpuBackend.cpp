@@ -19,6 +19,9 @@ class CholmodSpdSolver final : public SpdSolver {
  public:
   CholmodSpdSolver(const SparseMatrix& A, bool measureResidual) : size_(A.rows()), measureResidual_(measureResidual) {
     if (A.rows() != A.cols()) throwNumerical("SPD solver: matrix is not square");
+    // A failed factorization is reported by the Error below (and its callers' fallbacks),
+    // not by CHOLMOD's own "matrix not positive definite" lines on the user's terminal.
+    factor_.cholmod().print = 0;
     columnMajor_ = A;
     factor_.compute(columnMajor_);
     if (factor_.info() != Eigen::Success) {
