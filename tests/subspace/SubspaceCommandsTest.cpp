@@ -60,6 +60,20 @@ TEST(SubspaceCommand, AskedForVulkanItWarnsThatItComputesOnTheCpuAndReportsCpu) 
   EXPECT_EQ(plain.err.find("warning"), std::string::npos) << plain.err;
 }
 
+TEST(SubspaceCommand, OnAMeshWithNonPlanarFacesItWarnsThatItsSpaceIsApproximate) {
+  // Even with -q: the shapes of such a space are not polyhedral, whatever the run says.
+  TempDir dir;
+  writeMesh(dir / "hypar.obj", generate::hyparGrid(6));
+  for (const std::string command : {"subspace", "explore"}) {
+    const auto result = runTool("-q " + command + " " + quoted(dir / "hypar.obj") +
+                                (command == "explore" ? " -o " + quoted(dir / "out.obj") : std::string()));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_NE(result.err.find("warning: plano " + command + ": the mesh's faces are not planar"), std::string::npos)
+        << result.err;
+    EXPECT_NE(result.err.find("plano planarize"), std::string::npos) << result.err;
+  }
+}
+
 TEST(SubspaceCommand, MixedSpaceReadsTheFacesFileAndRejectsAShortOne) {
   TempDir dir;
   writeMesh(dir / "cube.obj", generate::cube());

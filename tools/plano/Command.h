@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "compute/Backend.h"
+#include "subspace/LinearSpace.h"
 
 namespace plano::cli {
 
@@ -53,6 +54,17 @@ std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& c
 /// (unless --quiet) saying which part runs where.
 std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& options, const std::string& command,
                                                          const std::string& deviceWork);
+
+/// Above this largest relative face non-planarity (third over first singular value of a face's
+/// centred corners) a mesh is not planar to its file's rounding (real planar-quad meshes
+/// stored with 6 digits reach ~1e-4), and its linear spaces are only approximate.
+constexpr double kLinearSpaceNonPlanarityWarning = 1e-3;
+
+/// For a linear-space command on a mesh whose faces are not planar (kLinearSpaceNonPlanarityWarning):
+/// a warning on stderr, even with --quiet, that the space is built from the faces' best-fit
+/// planes with a rank tolerance grown to match, so that its shapes are polyhedral only to
+/// about that tolerance, and that the mesh should be planarized first.
+void warnIfFacesAreNotPlanar(const std::string& command, const subspace::LinearSpace& space);
 
 /// Progress line on stderr unless --quiet.
 void progress(const GlobalOptions& options, const std::string& message);

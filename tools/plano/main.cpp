@@ -32,6 +32,14 @@ std::string warnComputesOnCpu(const GlobalOptions& options, const std::string& c
   return "cpu";
 }
 
+void warnIfFacesAreNotPlanar(const std::string& command, const subspace::LinearSpace& space) {
+  if (!(space.B.maxNonPlanarity > kLinearSpaceNonPlanarityWarning)) return;
+  std::cerr << "warning: plano " << command << ": the mesh's faces are not planar (largest relative non-planarity "
+            << space.B.maxNonPlanarity << "): its linear space is built from the faces' best-fit planes with rank "
+            << "tolerance " << space.basisInfo.rankTolerance << ", and its shapes are polyhedral only to about that; "
+            << "planarize the mesh first (plano planarize)" << std::endl;
+}
+
 std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& options, const std::string& command,
                                                          const std::string& deviceWork) {
   auto backend = makeBackend(options);

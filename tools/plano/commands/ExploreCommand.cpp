@@ -66,6 +66,7 @@ RunFunction setup(CLI::App& app) {
     settings.constraints.up = Eigen::Vector3d(o->up[0], o->up[1], o->up[2]);
     const LinearSpace space =
         buildLinearSpace(mesh, requestedAssignment(o->space, o->facesFile, mesh.faceCount()), settings);
+    warnIfFacesAreNotPlanar("explore", space);
     progress(global, o->space + " space: dimension " + std::to_string(space.dof.dimension));
     EigenshapeSettings es;
     es.count = o->eigenshapes;

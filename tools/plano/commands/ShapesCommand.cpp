@@ -94,6 +94,7 @@ RunFunction setup(CLI::App& app) {
                 << info.supportVertices << " vertices move, ||BX||/||X|| = " << info.residual << "\n";
     } else {
       const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
+      warnIfFacesAreNotPlanar("shapes", space);
       FundamentalShapeSettings fs;
       fs.smoothness = o->smoothness;
       shape = fundamentalShape(*backend, space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), o->vertex, direction, fs);

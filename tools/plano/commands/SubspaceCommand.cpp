@@ -60,6 +60,7 @@ RunFunction setup(CLI::App& app) {
       spaces = reassignNonMaximalFaces(mesh, spaces, rs, &reassignment);
     }
     const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
+    warnIfFacesAreNotPlanar("subspace", space);
     const auto nonMaximal = findNonMaximalFaces(space, settings.constraints);
     const SubspaceTopology topology = computeTopology(mesh.faces, mesh.vertexCount());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

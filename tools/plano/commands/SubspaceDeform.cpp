@@ -27,6 +27,7 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   if (constraints.empty()) throwBadInput(request.constraints + ": no fixed vertex and no handle");
   const LinearSpace space =
       buildLinearSpace(mesh, requestedAssignment(request.space, request.facesFile, mesh.faceCount()));
+  warnIfFacesAreNotPlanar("deform", space);
   progress(global, request.space + " space: dimension " + std::to_string(space.dof.dimension));
   auto backend = makeBackend(global);
   SubspaceDeformationSettings settings;
