@@ -19,7 +19,7 @@ enum class EigenshapeStatus { Converged, NotConverged };
 
 struct EigenshapeInfo {
   EigenshapeStatus status = EigenshapeStatus::Converged;
-  bool dense = true;          ///< Dense solver (true) or Spectra Lanczos (false).
+  bool dense = true;          ///< Dense solver (true) or Spectra shift-invert Lanczos (false).
   Index iterations = 0;       ///< Spectra restarts (0 for dense).
   Index reducedSize = 0;      ///< Size of the eigenproblem solved (d1 for a separable basis).
 };
@@ -32,8 +32,10 @@ struct Eigenshapes {
 
 /// Lowest-frequency eigenshapes of the scalar Laplacian L (#V x #V, applied per
 /// coordinate) in the space with basis N. For a separable basis every scalar eigenvector
-/// yields three eigenshapes (x, y, z) of equal frequency. Throws Error(Numerical) when
-/// Spectra does not converge.
+/// yields three eigenshapes (x, y, z) of equal frequency. L must be positive semidefinite
+/// (a Laplacian): above `denseLimit` the eigenpairs come from a shift-invert Lanczos
+/// iteration on a Cholesky factor of N^T L N shifted just below 0. Throws
+/// Error(Numerical) when Spectra does not converge or no such factor exists.
 /// The reduced operator N^T L N, the d x d matrix whose eigenproblem this is, is formed on
 /// `backend` (Backend::reducedOperator); the small eigenproblem runs on the host.
 Eigenshapes computeEigenshapes(compute::Backend& backend, const SubspaceBasis& N, const compute::SparseMatrix& L,

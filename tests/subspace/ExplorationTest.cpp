@@ -56,6 +56,38 @@ TEST(Eigenshapes, SpectraAgreesWithTheDenseSolver) {
   EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-8);
 }
 
+TEST(Eigenshapes, ShiftInvertLanczosFindsTheZeroFrequenciesAndTheDenseShapesInFewRestarts) {
+  // The affine space of a grid holds the translations (frequency 0, once per coordinate) and
+  // a cluster of low frequencies: the iteration works on (R + shift)^-1, where they are the
+  // largest eigenvalues and far apart.
+  const PolygonMesh mesh = generate::translationalSurface(14, 14);
+  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
+  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(SpaceKind::Affine, mesh.faceCount()));
+  EigenshapeSettings dense, lanczos;
+  dense.count = lanczos.count = 12;
+  lanczos.denseLimit = 0;
+  EigenshapeInfo info;
+  const Eigenshapes a = computeEigenshapes(space.N, L, dense);
+  const Eigenshapes b = computeEigenshapes(space.N, L, lanczos, &info);
+  ASSERT_FALSE(info.dense);
+  EXPECT_LE(info.iterations, 5);
+  EXPECT_LE(b.frequencies.head(3).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-9);
+  // The same shapes: each of b's lies in the span of a's eigenshapes of its frequency (but
+  // the highest frequency, whose eigenspace the count may cut: the square grid's symmetry
+  // makes eigenvalues double).
+  for (Index k = 0; k < b.count() && b.frequencies[k] < a.frequencies.maxCoeff() - 1e-6; ++k) {
+    Eigen::MatrixXd sameFrequency(a.coefficients.rows(), 0);
+    for (Index j = 0; j < a.count(); ++j) {
+      if (std::abs(a.frequencies[j] - b.frequencies[k]) > 1e-6) continue;
+      sameFrequency.conservativeResize(Eigen::NoChange, sameFrequency.cols() + 1);
+      sameFrequency.rightCols(1) = a.coefficients.col(j);
+    }
+    const Eigen::VectorXd w = b.coefficients.col(k);
+    EXPECT_LE((w - sameFrequency * (sameFrequency.transpose() * w)).norm(), 1e-6) << k;
+  }
+}
+
 TEST(Eigenshapes, BandPassStaysPolyhedral) {
   const PolygonMesh mesh = generate::hexagonalDome(3);
   const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(SpaceKind::Vertical, mesh.faceCount()));
