@@ -8,17 +8,10 @@
 #include "compute/cpu/SymmetricProduct.h"
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "support/TestMeshes.h"
 
 namespace plano::test {
 namespace {
-
-Eigen::MatrixXd gaussianFactor(Index rows, Index columns, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> value;
-  Eigen::MatrixXd M(rows, columns);
-  for (Index i = 0; i < M.size(); ++i) M.data()[i] = value(rng);
-  return M;
-}
 
 /// A path-graph Laplacian on `vertices` vertices plus `extra` random symmetric couplings.
 compute::SparseMatrix pathLaplacianWithCouplings(Index vertices, unsigned seed, bool symmetric = true) {
@@ -41,24 +34,20 @@ compute::SparseMatrix pathLaplacianWithCouplings(Index vertices, unsigned seed, 
   return S;
 }
 
-double relativeProductError(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-300);
-}
-
 TEST(SymmetricProduct, LowerBlocksMirroredEqualTheFullProductOfASymmetricOne) {
   // 600 columns: five blocks of columns, the last one short.
   const compute::SparseMatrix S = pathLaplacianWithCouplings(700, 1);
-  const Eigen::MatrixXd N = gaussianFactor(700, 600, 2);
+  const Eigen::MatrixXd N = gaussianMatrix(700, 600, 2);
   const Eigen::MatrixXd SN = S * N;
   const Eigen::MatrixXd R = compute::symmetricTransposeProduct(N, SN);
   const Eigen::MatrixXd full = N.transpose() * SN;
-  EXPECT_LT(relativeProductError(R, full), 1e-13);
+  EXPECT_LT(relativeMaxDifference(R, full), 1e-13);
   EXPECT_EQ(R, R.transpose());
 }
 
 TEST(SymmetricProduct, TheReducedOperatorOfANonSymmetricOperatorIsTheFullProduct) {
   const compute::SparseMatrix S = pathLaplacianWithCouplings(300, 3, false);
-  const Eigen::MatrixXd N = gaussianFactor(300, 280, 4);
+  const Eigen::MatrixXd N = gaussianMatrix(300, 280, 4);
   const Eigen::MatrixXd R = compute::reducedOperatorReference(S, N, 1);
   EXPECT_EQ(R, Eigen::MatrixXd(N.transpose() * (S * N)));
   EXPECT_GT((R - R.transpose()).cwiseAbs().maxCoeff(), 1.0);
@@ -67,7 +56,7 @@ TEST(SymmetricProduct, TheReducedOperatorOfANonSymmetricOperatorIsTheFullProduct
 TEST(SymmetricProduct, TheReducedOperatorOfASymmetricOperatorIsSymmetricOnEveryCoordinateCount) {
   const compute::SparseMatrix S = pathLaplacianWithCouplings(200, 5);
   for (int k : {1, 3}) {
-    const Eigen::MatrixXd N = gaussianFactor(k * 200, 300, 6 + k);
+    const Eigen::MatrixXd N = gaussianMatrix(k * 200, 300, 6 + k);
     const Eigen::MatrixXd R = compute::reducedOperatorReference(S, N, k);
     EXPECT_EQ(R, R.transpose()) << k;
     // k = 3: S acts on each coordinate of a vertex alike, (S (x) I_3) N.
@@ -77,12 +66,12 @@ TEST(SymmetricProduct, TheReducedOperatorOfASymmetricOperatorIsSymmetricOnEveryC
         SN.row(k * v + c).setZero();
         for (compute::SparseMatrix::InnerIterator it(S, v); it; ++it) SN.row(k * v + c) += it.value() * N.row(k * it.col() + c);
       }
-    EXPECT_LT(relativeProductError(R, N.transpose() * SN), 1e-13) << k;
+    EXPECT_LT(relativeMaxDifference(R, N.transpose() * SN), 1e-13) << k;
   }
 }
 
 TEST(SymmetricProduct, ACancellationRequestStopsIt) {
-  const Eigen::MatrixXd N = gaussianFactor(50, 300, 8);
+  const Eigen::MatrixXd N = gaussianMatrix(50, 300, 8);
   requestCancellation();
   EXPECT_THROW(compute::symmetricTransposeProduct(N, N), Interrupted);
   clearCancellation();
@@ -90,7 +79,7 @@ TEST(SymmetricProduct, ACancellationRequestStopsIt) {
 }
 
 TEST(SymmetricProduct, FactorsOfDifferentSizesAreAUsageError) {
-  const Eigen::MatrixXd A = gaussianFactor(10, 4, 9), B = gaussianFactor(10, 5, 10);
+  const Eigen::MatrixXd A = gaussianMatrix(10, 4, 9), B = gaussianMatrix(10, 5, 10);
   try {
     compute::symmetricTransposeProduct(A, B);
     FAIL() << "no error";

@@ -13,6 +13,7 @@
 #include "subspace/FundamentalShapes.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/MeshLaplacian.h"
+#include "support/TestMeshes.h"
 
 namespace plano::test {
 namespace {
@@ -30,19 +31,6 @@ compute::SparseMatrix randomOperator(Index vertices, int perRow, unsigned seed) 
   return S;
 }
 
-Eigen::MatrixXd randomBasis(Index rows, Index columns, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> value;
-  Eigen::MatrixXd N(rows, columns);
-  for (Index i = 0; i < N.size(); ++i) N.data()[i] = value(rng);
-  return N;
-}
-
-/// max |a - b| / max |b|.
-double relativeDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-300);
-}
-
 using VulkanReducedOperator = VulkanTest;
 
 TEST_F(VulkanReducedOperator, MatchesTheCpuOnRandomOperatorsAndBases) {
@@ -50,35 +38,35 @@ TEST_F(VulkanReducedOperator, MatchesTheCpuOnRandomOperatorsAndBases) {
   // side), one and three coordinates per vertex.
   const compute::SparseMatrix S = randomOperator(301, 7, 1);
   for (const auto& [k, columns] : {std::pair{1, 37}, std::pair{3, 29}, std::pair{1, 150}}) {
-    const Eigen::MatrixXd N = randomBasis(k * 301, columns, 2 + k + columns);
+    const Eigen::MatrixXd N = gaussianMatrix(k * 301, columns, 2 + k + columns);
     const Eigen::MatrixXd R = backend().reducedOperator(S, N, k);
     ASSERT_EQ(R.rows(), N.cols());
     ASSERT_EQ(R.cols(), N.cols());
-    EXPECT_LT(relativeDifference(R, compute::reducedOperatorReference(S, N, k)), 1e-12)
+    EXPECT_LT(relativeMaxDifference(R, compute::reducedOperatorReference(S, N, k)), 1e-12)
         << k << " coordinates, " << columns << " columns";
   }
 }
 
 TEST_F(VulkanReducedOperator, ABasisSplitIntoManyBlocksGivesTheSameOperator) {
   const compute::SparseMatrix S = randomOperator(200, 5, 4);
-  const Eigen::MatrixXd N = randomBasis(3 * 200, 41, 5);
+  const Eigen::MatrixXd N = gaussianMatrix(3 * 200, 41, 5);
   // Five columns per block: nine blocks of columns, 81 products of blocks.
   vk::ReducedOperatorKernel kernel(context(), 5 * static_cast<std::size_t>(N.rows()) * sizeof(double));
   const Eigen::MatrixXd blocked = kernel.run(S, N, 3);
-  EXPECT_LT(relativeDifference(blocked, compute::reducedOperatorReference(S, N, 3)), 1e-12);
-  EXPECT_LT(relativeDifference(blocked, backend().reducedOperator(S, N, 3)), 1e-13);
+  EXPECT_LT(relativeMaxDifference(blocked, compute::reducedOperatorReference(S, N, 3)), 1e-12);
+  EXPECT_LT(relativeMaxDifference(blocked, backend().reducedOperator(S, N, 3)), 1e-13);
 }
 
 TEST_F(VulkanReducedOperator, ATallBasisSplitIntoChunksOfRowsGivesTheSameOperator) {
   // 4 500 rows: three chunks of the long dimension (the last one short), summed at the end.
   const compute::SparseMatrix S = randomOperator(1500, 6, 10);
-  const Eigen::MatrixXd N = randomBasis(3 * 1500, 70, 11);
-  EXPECT_LT(relativeDifference(backend().reducedOperator(S, N, 3), compute::reducedOperatorReference(S, N, 3)), 1e-12);
+  const Eigen::MatrixXd N = gaussianMatrix(3 * 1500, 70, 11);
+  EXPECT_LT(relativeMaxDifference(backend().reducedOperator(S, N, 3), compute::reducedOperatorReference(S, N, 3)), 1e-12);
 }
 
 TEST_F(VulkanReducedOperator, OnlyTheSmallResultComesBack) {
   const compute::SparseMatrix S = randomOperator(500, 6, 6);
-  const Eigen::MatrixXd N = randomBasis(500, 24, 7);
+  const Eigen::MatrixXd N = gaussianMatrix(500, 24, 7);
   (void)backend().reducedOperator(S, N, 1);  // pipelines built
   const auto before = backend().transfers();
   (void)backend().reducedOperator(S, N, 1);
@@ -111,7 +99,7 @@ TEST_F(VulkanReducedOperator, EigenshapesAndFundamentalShapesMatchTheCpuOnGenera
   for (subspace::SpaceKind kind : {subspace::SpaceKind::Affine, subspace::SpaceKind::Parallel}) {
     const subspace::LinearSpace space =
         subspace::buildLinearSpace(mesh, subspace::uniformAssignment(kind, mesh.faceCount()));
-    EXPECT_LT(relativeDifference(space.N.reducedOperator(backend(), L), space.N.reducedOperator(L)), 1e-12)
+    EXPECT_LT(relativeMaxDifference(space.N.reducedOperator(backend(), L), space.N.reducedOperator(L)), 1e-12)
         << subspace::toString(kind);
     subspace::EigenshapeSettings settings;
     settings.count = 12;

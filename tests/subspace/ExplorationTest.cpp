@@ -42,35 +42,41 @@ TEST(Eigenshapes, AreOrthonormalInTheSpaceAndSortedByFrequency) {
   }
 }
 
-TEST(Eigenshapes, SpectraAgreesWithTheDenseSolver) {
-  const PolygonMesh mesh = generate::translationalSurface(8, 8);
-  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
-  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(SpaceKind::Parallel, mesh.faceCount()));
-  EigenshapeSettings dense, lanczos;
-  dense.count = lanczos.count = 6;
-  lanczos.denseLimit = 0;
+/// The eigenshapes of a side x side grid's space by the dense solver and by the iterative
+/// one (denseLimit 0), with the iterative one's info.
+struct DenseAndIterative {
+  Eigenshapes dense, iterative;
   EigenshapeInfo info;
-  const Eigenshapes a = computeEigenshapes(space.N, L, dense);
-  const Eigenshapes b = computeEigenshapes(space.N, L, lanczos, &info);
-  EXPECT_FALSE(info.dense);
-  EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-8);
+};
+
+DenseAndIterative eigenshapesBothWays(Index side, SpaceKind kind, Index count) {
+  const PolygonMesh mesh = generate::translationalSurface(side, side);
+  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
+  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(kind, mesh.faceCount()));
+  EigenshapeSettings dense, iterative;
+  dense.count = iterative.count = count;
+  iterative.denseLimit = 0;
+  DenseAndIterative out;
+  out.dense = computeEigenshapes(space.N, L, dense);
+  out.iterative = computeEigenshapes(space.N, L, iterative, &out.info);
+  return out;
 }
 
-TEST(Eigenshapes, ShiftInvertLanczosFindsTheZeroFrequenciesAndTheDenseShapesInFewRestarts) {
+TEST(Eigenshapes, SpectraAgreesWithTheDenseSolver) {
+  const DenseAndIterative r = eigenshapesBothWays(8, SpaceKind::Parallel, 6);
+  EXPECT_FALSE(r.info.dense);
+  EXPECT_LE((r.dense.frequencies - r.iterative.frequencies).cwiseAbs().maxCoeff(), 1e-8);
+}
+
+TEST(Eigenshapes, ShiftInvertLanczosFindsTheZeroFrequenciesAndTheDenseSolversShapes) {
   // The affine space of a grid holds the translations (frequency 0, once per coordinate) and
   // a cluster of low frequencies: the iteration works on (R + shift)^-1, where they are the
   // largest eigenvalues and far apart.
-  const PolygonMesh mesh = generate::translationalSurface(14, 14);
-  const compute::SparseMatrix L = uniformLaplacian(mesh.faces, mesh.vertexCount());
-  const LinearSpace space = buildLinearSpace(mesh, uniformAssignment(SpaceKind::Affine, mesh.faceCount()));
-  EigenshapeSettings dense, lanczos;
-  dense.count = lanczos.count = 12;
-  lanczos.denseLimit = 0;
-  EigenshapeInfo info;
-  const Eigenshapes a = computeEigenshapes(space.N, L, dense);
-  const Eigenshapes b = computeEigenshapes(space.N, L, lanczos, &info);
-  ASSERT_FALSE(info.dense);
-  EXPECT_LE(info.iterations, 5);
+  const DenseAndIterative r = eigenshapesBothWays(14, SpaceKind::Affine, 12);
+  const Eigenshapes& a = r.dense;
+  const Eigenshapes& b = r.iterative;
+  ASSERT_FALSE(r.info.dense);
+  EXPECT_LE(r.info.iterations, 5);
   EXPECT_LE(b.frequencies.head(3).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-9);
   // The same shapes: each of b's lies in the span of a's eigenshapes of its frequency (but

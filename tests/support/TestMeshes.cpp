@@ -1,7 +1,9 @@
 #include "support/TestMeshes.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -24,6 +26,18 @@ Positions perturbed(const Positions& vertices, double amplitude, unsigned seed) 
 
 double maxAbsDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).cwiseAbs().maxCoeff();
+}
+
+double relativeMaxDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return maxAbsDifference(a, b) / std::max(b.cwiseAbs().maxCoeff(), 1e-300);
+}
+
+Eigen::MatrixXd gaussianMatrix(Index rows, Index columns, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> value;
+  Eigen::MatrixXd M(rows, columns);
+  for (Index i = 0; i < M.size(); ++i) M.data()[i] = value(rng);
+  return M;
 }
 
 TempDir::TempDir() {

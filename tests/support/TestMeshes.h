@@ -28,6 +28,11 @@ Positions perturbed(const Positions& vertices, double amplitude, unsigned seed =
 
 /// Largest absolute entry of a - b.
 double maxAbsDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+/// max |a - b| / max |b|: a difference relative to b's scale.
+double relativeMaxDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+
+/// A rows x columns matrix of standard normal entries (deterministic seed).
+Eigen::MatrixXd gaussianMatrix(Index rows, Index columns, unsigned seed);
 
 /// A temporary folder removed at destruction.
 class TempDir {
