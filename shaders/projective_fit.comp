@@ -42,9 +42,6 @@ layout(push_constant) uniform Push {
   double rankThreshold;
 } pc;
 
-// kOriginAtInfinityTolerance of LocalFit.h.
-#define ORIGIN_AT_INFINITY_TOLERANCE 1e-12LF
-
 const int N = 15;
 double privateA[N * N];  // row-major: R, then its decomposition
 double privateC[N];      // Q^T r, then the solution
@@ -274,18 +271,13 @@ void main() {
 
     // Back to the original coordinates: T = S_p T' S_q^{-1}, where (p, 1) S_p = (p - c_p, 1)
     // replaces row 3 by T'[3, :] - c_p . T'[0..2, :], and S_q^{-1} adds c_qj T[:, 3] to
-    // column j < 3. Then T(3,3) = 1, unless the origin goes to infinity (flagged below).
+    // column j < 3. T keeps T''s scale: mean reciprocal scale 1 (LocalFit.h says why).
     for (int col = 0; col < 4; ++col) {
       t(4 * col + 3) -= dot(sourceCentroid, dvec3(t(4 * col), t(4 * col + 1), t(4 * col + 2)));
     }
     for (int j = 0; j < 3; ++j) {
       for (int r = 0; r < 4; ++r) t(4 * j + r) += targetCentroid[j] * t(12 + r);
     }
-    double norm2 = 0.0;
-    for (int l = 0; l < 16; ++l) norm2 += t(l) * t(l);
-    const bool originAtInfinity = !(abs(t(15)) > ORIGIN_AT_INFINITY_TOLERANCE * sqrt(norm2));
-    const double normalizer = originAtInfinity ? sqrt(norm2) : t(15);
-    for (int l = 0; l < 16; ++l) t(l) /= normalizer;
 
     const dvec4 column3 = dvec4(t(12), t(13), t(14), t(15));
     double squaredResidual = 0.0;
@@ -301,8 +293,7 @@ void main() {
       }
     }
     for (int l = 0; l < 16; ++l) maps[16 * i + l] = t(l);
-    residuals[i] = originAtInfinity ? packDouble2x32(uvec2(0u, 0x7FF00000u))  // +infinity
-                                    : (k > 0 ? sqrt(squaredResidual / double(3 * k)) : 0.0);
+    residuals[i] = k > 0 ? sqrt(squaredResidual / double(3 * k)) : 0.0;
     ranks[i] = rank;
   }
 }

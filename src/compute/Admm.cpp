@@ -12,6 +12,11 @@
 namespace plano::compute {
 namespace {
 
+/// The least primal tolerance an eps gives (AdmmSettings::epsilonToleranceFraction), well
+/// above the rounding of rows whose terms are of order 1 (~1e-16): targets compatible to
+/// rounding have eps_0 ~1e-17, and their attempt must converge at its start.
+constexpr double kPrimalToleranceFloor = 1e-12;
+
 /// Column-wise inf-norms; NaN propagates (Eigen's maxCoeff would skip it).
 Eigen::VectorXd columnInfNorms(const Eigen::MatrixXd& m) {
   Eigen::VectorXd norms = Eigen::VectorXd::Zero(m.cols());
@@ -170,6 +175,9 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
     : kernels_(std::move(kernels)), n_(n), m_(m), settings_(settings), rho_(settings.rho) {
   if (settings_.checkInterval < 1) throwUsage("ADMM: checkInterval must be at least 1");
   if (settings_.stallIterations < 0) throwUsage("ADMM: stallIterations must be >= 0 (0: never stop as stalled)");
+  if (!(settings_.epsilonToleranceFraction >= 0.0) || std::isinf(settings_.epsilonToleranceFraction)) {
+    throwUsage("ADMM: epsilonToleranceFraction must be a finite number >= 0 (0: absoluteTolerance alone)");
+  }
   if (!(settings_.stallChange >= 0.0 && settings_.stallChange < 1.0)) {
     throwUsage("ADMM: stallChange must be in [0, 1)");
   }
@@ -365,6 +373,12 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     kernels_->start(q, lower, upper, x, y);
   }
 
+  // An attempt resolves its own eps (AdmmSettings::epsilonToleranceFraction).
+  const double ofEpsilon = settings_.epsilonToleranceFraction;
+  const double primalAbsoluteTolerance =
+      relaxed && relaxed->epsilon > 0.0 && ofEpsilon > 0.0
+          ? std::max(std::min(settings_.absoluteTolerance, ofEpsilon * relaxed->epsilon), kPrimalToleranceFloor)
+          : settings_.absoluteTolerance;
   // Residuals, tolerances and the rho balance at the current iterate. Returns true when converged.
   AdmmMeasures s;
   double rhoBalance = 1.0;
@@ -376,7 +390,7 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     info.dualResidual = maxOf(s.dualResidual);
     const double primalScale = std::max(maxOf(s.Cx), maxOf(s.z));
     const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
-    const double epsPrimal = settings_.absoluteTolerance + settings_.relativeTolerance * primalScale;
+    const double epsPrimal = primalAbsoluteTolerance + settings_.relativeTolerance * primalScale;
     const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
     const double tiny = 1e-30;
     rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /

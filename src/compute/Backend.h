@@ -28,14 +28,13 @@ struct ReducedArapProblem;  // compute/ReducedArap.h
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 /// Result of the batched local step (projective-maps paper, Eq. 3), one entry per face.
-/// Row-vector convention: (p_i, 1) T_f = shat_i (q_i, 1) with T_f(3, 3) = 1, where
-/// shat_i = 1 / s_{f,i} is the reciprocal scale factor of corner i.
+/// Row-vector convention: (p_i, 1) T_f = shat_i (q_i, 1), where shat_i = 1 / s_{f,i} is the
+/// reciprocal scale factor of corner i; each T_f is scaled to mean shat_i 1 over its face
+/// (projective::fitProjectiveMap says why not the paper's T_f(3, 3) = 1).
 struct ProjectiveFits {
   std::vector<Eigen::Matrix4d> maps;      ///< #F maps.
   std::vector<double> reciprocalScales;   ///< One per corner, in the FaceList's CSR order.
-  /// Per face: RMS of the fit's equation residuals; +infinity when T_f(3, 3) = 1 is
-  /// impossible (the map sends the origin to infinity; that map is then scaled to unit norm).
-  std::vector<double> residuals;
+  std::vector<double> residuals;          ///< Per face: RMS of the fit's equation residuals.
   std::vector<int> ranks;                 ///< Per face: numerical rank of the fit's system.
 };
 

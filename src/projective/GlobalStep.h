@@ -11,8 +11,10 @@
 //
 // Structure used (see notes on the framework): with those scale factors the fourth
 // columns of the targets already satisfy every row (all weights are 1), and with
-// A(3, 3) = 1 fixed they are the only choice on a face whose plane misses the origin
-// (normalized coordinates make this the rule), so A_f[:, 3] = T_f[:, 3]. Columns 0..2 are
+// A_f(3, 3) = T_f(3, 3) fixed (the map's scale: the paper fixes it to 1, fitted maps come
+// with mean reciprocal scale 1, LocalFit.h) they are the only choice on a face whose plane
+// misses the origin (normalized coordinates make this the rule), so A_f[:, 3] = T_f[:, 3].
+// The objective weighs face f by the square of T_f's scale. Columns 0..2 are
 // three independent QPs with one matrix: one factorization, three right-hand sides.
 //
 // Compatibility rows: at every unconstrained vertex, the image of its first corner's face
@@ -104,7 +106,7 @@ class GlobalStep {
              const GlobalStepSettings& settings = {});
 
   /// Project the targets onto the compatible shape space.
-  ///   targets    in: #F maps T_f (normalized coordinates, T(3, 3) = 1).
+  ///   targets    in: #F maps T_f (normalized coordinates; T(3, 3) = 1 or a fit's scale).
   ///   positions  in: #constrained x 3 world positions of the constrained vertices, in the
   ///              order given to the constructor (ignored when there are none).
   ///   result     out: the maps A_f and their reciprocal scales (those of the targets).

@@ -2,7 +2,6 @@
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <limits>
 
 namespace plano::projective {
 
@@ -90,14 +89,18 @@ ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::spa
     }
   }
   // Back to the original coordinates: T = S_p T' S_q^{-1}, with (p, 1) S_p = (p - c_p, 1)
-  // and (q - c_q, 1) S_q^{-1} = (q, 1), then T(3, 3) = 1 again.
+  // and (q - c_q, 1) S_q^{-1} = (q, 1). T keeps T''s scale: its reciprocal scales are T''s,
+  // whose mean over the corners is 1. The paper's T(3, 3) = 1 would rescale by the
+  // reciprocal scale of the global origin instead, which is tiny on a face whose map sends
+  // the origin near its plane at infinity (a face small against its distance from the
+  // origin, with a strong perspective part): that face's entries then grew by its inverse
+  // (to 884 on an Enneper mesh's first Catmull-Clark level), and with them its weight in
+  // the global step's objective (squared) and the ADMM's scales.
   Eigen::Matrix4d Sp = Eigen::Matrix4d::Identity();
   Sp.block<1, 3>(3, 0) = -cp.transpose();
   Eigen::Matrix4d SqInverse = Eigen::Matrix4d::Identity();
   SqInverse.block<1, 3>(3, 0) = cq.transpose();
-  const Eigen::Matrix4d T = Sp * centred * SqInverse;
-  const bool originAtInfinity = !(std::abs(T(3, 3)) > kOriginAtInfinityTolerance * T.norm());
-  fit.map = originAtInfinity ? Eigen::Matrix4d(T / T.norm()) : Eigen::Matrix4d(T / T(3, 3));
+  fit.map = Sp * centred * SqInverse;
 
   fit.reciprocalScales.resize(k);
   double squaredResidual = 0.0;
@@ -108,8 +111,6 @@ ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::spa
     squaredResidual += (image.head<3>() - image[3] * q[i].transpose()).squaredNorm();
   }
   fit.residual = rows > 0 ? std::sqrt(squaredResidual / static_cast<double>(rows)) : 0.0;
-  // The paper's normalization T(3, 3) = 1 does not exist for this face: flag it.
-  if (originAtInfinity) fit.residual = std::numeric_limits<double>::infinity();
   return fit;
 }
 

@@ -6,19 +6,16 @@
 
 namespace plano::projective {
 
-/// A fitted face map. Row-vector convention: (p_i, 1) T = shat_i (q_i, 1), T(3, 3) = 1,
-/// where shat_i = 1 / s_{f,i} is the reciprocal of the paper's scale factor.
+/// A fitted face map. Row-vector convention: (p_i, 1) T = shat_i (q_i, 1), where shat_i =
+/// 1 / s_{f,i} is the reciprocal of the paper's scale factor, normalized so that the mean of
+/// shat_i over the face's corners is 1 (see fitProjectiveMap).
 struct ProjectiveFit {
   Eigen::Matrix4d map = Eigen::Matrix4d::Identity();
   std::vector<double> reciprocalScales;  ///< One per corner.
-  /// RMS residual of the 3k fit equations (0 for an exact fit); +infinity when the map
-  /// sends the origin to infinity (T(3, 3) ~ 0, see fitProjectiveMap).
+  /// RMS residual of the 3k fit equations (0 for an exact fit).
   double residual = 0.0;
   int rank = 0;           ///< Numerical rank of the 3k x 15 system.
 };
-
-/// Relative size of T(3, 3) below which a fitted map counts as sending the origin to infinity.
-inline constexpr double kOriginAtInfinityTolerance = 1e-12;
 
 struct LocalFitSettings {
   /// Project both corner sets onto their best-fitting planes first (§5 step 1), which
@@ -39,9 +36,13 @@ struct LocalFitSettings {
 /// and target), where T'(3, 3) = 1 means "mean reciprocal scale 1": uncentred, more than
 /// four corners that are not an exact projective image admit the degenerate exact solution
 /// T = n_h r^T (n_h the homogeneous source plane), which collapses the face (all shat_i = 0).
-/// T' is then converted back and rescaled to T(3, 3) = 1, and shat_i = (p_i, 1) T[:, 3].
-/// If |T(3, 3)| <= kOriginAtInfinityTolerance * ||T|| (the map sends the global origin to
-/// infinity), T is scaled to unit Frobenius norm instead and the residual is +infinity.
+/// T' is then converted back, keeping its scale: shat_i = (p_i, 1) T[:, 3] has mean 1 over
+/// the face. This departs from the paper's T(3, 3) = 1 (§3), which normalizes every face at
+/// the global origin: a projective map is the same map at any scale, but the global step's
+/// objective ||A_f - T_f||^2 weighs each face by its map's scale squared, and T(3, 3) = 1
+/// blows that scale up (without bound, or flips its sign) on a face whose map sends the
+/// origin near its plane at infinity. With mean reciprocal scale 1 every face weighs alike,
+/// as every ideal (affine) map does; an affine fit has T(3, 3) = 1 either way.
 /// Coordinates should be centred and scaled to unit size (see projective-notes).
 ProjectiveFit fitProjectiveMap(std::span<const Eigen::Vector3d> source, std::span<const Eigen::Vector3d> target,
                                const LocalFitSettings& settings = {});

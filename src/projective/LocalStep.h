@@ -20,7 +20,7 @@ struct LocalStepResult {
 /// checks of fitFaceMaps (Error(BadInput) for the wrong size or a non-finite entry).
 Positions normalizedTargetPositions(const ShapeSpace& space, const Positions& target);
 
-/// Fit T_f for every face: (p_i, 1) T_f = shat_{f,i} (q_i, 1), T_f(3, 3) = 1, both corner
+/// Fit T_f for every face: (p_i, 1) T_f = shat_{f,i} (q_i, 1), the face's mean shat 1, both corner
 /// sets first projected onto their best-fitting planes (§5 step 1); the solution closest
 /// to the identity when not unique, least squares when over-determined.
 ///   backend  in: where the batched fit runs.

@@ -2,7 +2,8 @@
 // The projective shape space of a base polyhedral mesh (projective-maps paper, §3, §3.1).
 //
 // A deformed mesh is parametrized by one 4x4 projective map A_f per face (row-vector
-// convention: (p_i, 1) A_f is proportional to (q_i, 1), normalized by A_f(3, 3) = 1) and
+// convention: (p_i, 1) A_f is proportional to (q_i, 1); the paper normalizes A_f(3, 3) = 1,
+// maps fitted by the local step have mean reciprocal scale 1 over their face) and
 // per-corner scale factors s_{f,i} with s_{f,i} (p_i, 1) A_f = (q_i, 1) (Eq. 2). Faces of
 // any degree >= 3 carry a single map. All maps act on normalized coordinates (see
 // Normalization.h); positions are mapped back to world coordinates on output.
@@ -19,7 +20,7 @@ namespace plano::projective {
 /// One map per face and the reciprocal scale factor shat_{f,i} = 1 / s_{f,i} of every
 /// corner, in the FaceList's CSR corner order.
 struct FaceMaps {
-  std::vector<Eigen::Matrix4d> maps;     ///< #F maps, A(3, 3) = 1.
+  std::vector<Eigen::Matrix4d> maps;     ///< #F maps (any scale: positions dehomogenize).
   std::vector<double> reciprocalScales;  ///< #corners, shat = (p_i, 1) A_f[:, 3].
 };
 

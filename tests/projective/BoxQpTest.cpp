@@ -279,5 +279,28 @@ TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
   EXPECT_EQ(yAlone.size(), 0);
 }
 
+TEST(BoxQp, AnAttemptWithEpsBelowTheAbsoluteToleranceResolvesItsOwnEps) {
+  // Rows within eps = 1e-8 of zero (the global step's compatibility rows late in a loop), far
+  // below the ADMM's absolute tolerance 1e-6. The ADMM's own point (no polish) keeps every row
+  // within eps and a tenth of it (AdmmSettings::epsilonToleranceFraction); with the fraction
+  // off, the absolute tolerance alone let rows miss their bounds by more than eps.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 2, 11);
+  const double eps = 1e-8;
+  const compute::RelaxedBounds bounds{Eigen::MatrixXd::Zero(5, 2), std::vector<char>(5, 1), eps};
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.polish = false;
+  const auto violationWith = [&](double fraction) {
+    settings.epsilonToleranceFraction = fraction;
+    BoxQpSolver solver(backend, qp.P, qp.C, settings);
+    Eigen::MatrixXd x, y;
+    const BoxQpInfo info = solver.solve(qp.q, bounds, x, y);
+    EXPECT_EQ(info.status, BoxQpStatus::Solved) << "fraction " << fraction;
+    return info.maxBoundViolation;
+  };
+  EXPECT_LE(violationWith(0.1), 0.1 * eps * (1.0 + 1e-6));
+  EXPECT_GT(violationWith(0.0), eps);
+}
+
 }  // namespace
 }  // namespace plano::projective

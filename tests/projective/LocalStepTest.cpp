@@ -30,6 +30,13 @@ std::vector<Eigen::Vector3d> tiltedPolygon(int k) {
 
 Eigen::RowVector4d hom(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z(), 1.0}; }
 
+/// The mean of a fit's reciprocal scales over its corners (the fit's normalization: 1).
+double meanReciprocalScale(const ProjectiveFit& fit) {
+  double sum = 0.0;
+  for (const double s : fit.reciprocalScales) sum += s;
+  return sum / static_cast<double>(fit.reciprocalScales.size());
+}
+
 TEST(LocalFit, RecoversPerspectiveImagesOfQuadsPentagonsAndHexagonsExactly) {
   const Eigen::Matrix4d H = test::samplePerspective();
   for (int k : {4, 5, 6}) {
@@ -41,7 +48,7 @@ TEST(LocalFit, RecoversPerspectiveImagesOfQuadsPentagonsAndHexagonsExactly) {
     }
     const ProjectiveFit fit = fitProjectiveMap(p, q);
     EXPECT_LT(fit.residual, 1e-12) << k << "-gon";
-    EXPECT_EQ(fit.map(3, 3), 1.0);
+    EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-14) << k << "-gon";
     // Scale factors: shat_i (q_i, 1) = (p_i, 1) T, and shat_i proportional to the true weights.
     const double ratio = fit.reciprocalScales[0] / hom(p[0]).dot(H.col(3));
     for (int i = 0; i < k; ++i) {
@@ -92,7 +99,7 @@ TEST(LocalFit, PicksTheSolutionClosestToTheIdentityForPlanarQuads) {
   }
   const ProjectiveFit fit = fitProjectiveMap(p, q);
   EXPECT_LT(fit.residual, 1e-12);
-  EXPECT_EQ(fit.map(3, 3), 1.0);
+  EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-14);
   const Eigen::Vector3d cp = centroid(p), cq = centroid(q);
   const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
   const Eigen::Vector4d m(n.x(), n.y(), n.z(), 0.0);
@@ -107,8 +114,8 @@ TEST(LocalFit, PerturbedPentagonsAndHexagonsDoNotCollapse) {
   // Five or six corners over-determine a planar homography. Uncentred, the equations had the
   // exact solution T = n_h r^T on the homogeneous source plane n_h, collapsing the face
   // (residual ~1e-16, all reciprocal scales ~0). Centred fits must give the least-squares
-  // map instead: scales near 1 (mean reciprocal scale 1 in face-centred coordinates) and a
-  // residual of the order of the perturbation.
+  // map instead: scales near 1 (mean reciprocal scale 1) and a residual of the order of the
+  // perturbation.
   const Eigen::Matrix4d H = test::samplePerspective();
   for (int k : {5, 6}) {
     const auto p = tiltedPolygon(k);
@@ -124,21 +131,11 @@ TEST(LocalFit, PerturbedPentagonsAndHexagonsDoNotCollapse) {
         q.push_back(x + 0.01 * Eigen::Vector3d(std::sin(5.0 * i + k), std::cos(3.0 * i), std::sin(7.0 * i + 1.0)));
       }
       const ProjectiveFit fit = fitProjectiveMap(p, q);
-      EXPECT_EQ(fit.map(3, 3), 1.0);
       EXPECT_GT(fit.residual, 1e-5) << k << "-gon";
       EXPECT_LT(fit.residual, 0.02) << k << "-gon";
-      // Face-centred reciprocal scales: shat'_i = shat_i * (scale of T') with mean 1.
-      const Eigen::Vector3d cp = centroid(p), cq = centroid(q);
-      Eigen::Matrix4d SpInverse = Eigen::Matrix4d::Identity();
-      SpInverse.block<1, 3>(3, 0) = cp.transpose();
-      Eigen::Matrix4d Sq = Eigen::Matrix4d::Identity();
-      Sq.block<1, 3>(3, 0) = -cq.transpose();
-      const double centredScale = (SpInverse * fit.map * Sq)(3, 3);
-      double mean = 0.0;
-      for (int i = 0; i < k; ++i) mean += fit.reciprocalScales[i] / centredScale;
-      EXPECT_NEAR(mean / k, 1.0, 1e-12) << k << "-gon";
+      EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-12) << k << "-gon";
       for (int i = 0; i < k; ++i) {
-        const double s = fit.reciprocalScales[i] / centredScale;
+        const double s = fit.reciprocalScales[i];
         EXPECT_GT(s, 0.5) << k << "-gon corner " << i;
         EXPECT_LT(s, 2.0) << k << "-gon corner " << i;
         if (!perspective) {
@@ -149,9 +146,34 @@ TEST(LocalFit, PerturbedPentagonsAndHexagonsDoNotCollapse) {
   }
 }
 
+TEST(LocalFit, AMapThatSendsTheOriginToInfinityKeepsUnitMeanScaleAndExactCorners) {
+  // A small square in the plane z = 0 (which holds the origin), 0.4 from the origin, and its
+  // image under a map whose weight vanishes at the origin: shat(p) = 2.5 x. The paper's
+  // T(3, 3) = 1 does not exist for this face (T(3, 3) = shat(origin) = 0).
+  const std::vector<Eigen::Vector3d> p = {{0.39, -0.01, 0.0}, {0.41, -0.01, 0.0}, {0.41, 0.01, 0.0}, {0.39, 0.01, 0.0}};
+  Eigen::Matrix4d H = Eigen::Matrix4d::Identity();
+  H.col(3) = Eigen::Vector4d(2.5, 0.0, 0.0, 0.0);
+  H(3, 0) = 0.1;
+  std::vector<Eigen::Vector3d> q;
+  for (const auto& x : p) {
+    const Eigen::RowVector4d h = hom(x) * H;
+    q.emplace_back(h.head<3>().transpose() / h[3]);
+  }
+  const ProjectiveFit fit = fitProjectiveMap(p, q);
+  EXPECT_LT(fit.residual, 1e-12);
+  EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-12);
+  EXPECT_NEAR(fit.map(3, 3), 0.0, 1e-10);
+  EXPECT_LT(fit.map.cwiseAbs().maxCoeff(), 10.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_NEAR(fit.reciprocalScales[i], 2.5 * p[i].x(), 1e-10) << "corner " << i;
+    const Eigen::RowVector4d image = hom(p[i]) * fit.map;
+    EXPECT_LT((image - fit.reciprocalScales[i] * hom(q[i])).cwiseAbs().maxCoeff(), 1e-12) << "corner " << i;
+  }
+}
+
 TEST(LocalFit, FitsDoNotDependOnWhereTheFaceSits) {
-  // Translating source and target conjugates the map; the reciprocal scales change only by
-  // one common factor (the new T(3, 3) normalization).
+  // Translating source and target conjugates the map; the reciprocal scales, normalized on
+  // the face itself, do not change.
   const auto p = tiltedPolygon(6);
   std::vector<Eigen::Vector3d> q;
   for (int i = 0; i < 6; ++i) q.push_back(1.1 * p[i] + 0.02 * Eigen::Vector3d(std::cos(2.0 * i), std::sin(i), 0.3));
@@ -163,11 +185,8 @@ TEST(LocalFit, FitsDoNotDependOnWhereTheFaceSits) {
   }
   const ProjectiveFit fit = fitProjectiveMap(p, q);
   const ProjectiveFit moved = fitProjectiveMap(pMoved, qMoved);
-  EXPECT_NEAR(moved.residual / fit.residual, moved.reciprocalScales[0] / fit.reciprocalScales[0], 1e-10);
-  for (int i = 0; i < 6; ++i) {
-    EXPECT_NEAR(moved.reciprocalScales[i] / moved.reciprocalScales[0],
-                fit.reciprocalScales[i] / fit.reciprocalScales[0], 1e-10);
-  }
+  EXPECT_NEAR(moved.residual, fit.residual, 1e-12);
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(moved.reciprocalScales[i], fit.reciprocalScales[i], 1e-10);
 }
 
 TEST(LocalStep, BatchedFitIsExactOnProjectiveImagesOfPolyhedralMeshes) {
