@@ -30,6 +30,16 @@ std::vector<Eigen::Vector3d> tiltedPolygon(int k) {
 
 Eigen::RowVector4d hom(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z(), 1.0}; }
 
+/// The points x H (row-vector convention), dehomogenized.
+std::vector<Eigen::Vector3d> imagesUnder(const Eigen::Matrix4d& H, const std::vector<Eigen::Vector3d>& points) {
+  std::vector<Eigen::Vector3d> images;
+  for (const auto& x : points) {
+    const Eigen::RowVector4d h = hom(x) * H;
+    images.emplace_back(h.head<3>().transpose() / h[3]);
+  }
+  return images;
+}
+
 /// The mean of a fit's reciprocal scales over its corners (the fit's normalization: 1).
 double meanReciprocalScale(const ProjectiveFit& fit) {
   double sum = 0.0;
@@ -41,11 +51,7 @@ TEST(LocalFit, RecoversPerspectiveImagesOfQuadsPentagonsAndHexagonsExactly) {
   const Eigen::Matrix4d H = test::samplePerspective();
   for (int k : {4, 5, 6}) {
     const auto p = tiltedPolygon(k);
-    std::vector<Eigen::Vector3d> q;
-    for (const auto& x : p) {
-      const Eigen::RowVector4d h = hom(x) * H;
-      q.emplace_back(h.head<3>().transpose() / h[3]);
-    }
+    const std::vector<Eigen::Vector3d> q = imagesUnder(H, p);
     const ProjectiveFit fit = fitProjectiveMap(p, q);
     EXPECT_LT(fit.residual, 1e-12) << k << "-gon";
     EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-14) << k << "-gon";
@@ -92,11 +98,7 @@ TEST(LocalFit, PicksTheSolutionClosestToTheIdentityForPlanarQuads) {
   // m = (n, -n.c) for the uncentred T; the two minimizers differ, as the Frobenius distance
   // to the identity is not invariant under translations.)
   const Eigen::Matrix4d H = test::samplePerspective();
-  std::vector<Eigen::Vector3d> q;
-  for (const auto& x : p) {
-    const Eigen::RowVector4d h = hom(x) * H;
-    q.emplace_back(h.head<3>().transpose() / h[3]);
-  }
+  const std::vector<Eigen::Vector3d> q = imagesUnder(H, p);
   const ProjectiveFit fit = fitProjectiveMap(p, q);
   EXPECT_LT(fit.residual, 1e-12);
   EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-14);
@@ -154,11 +156,7 @@ TEST(LocalFit, AMapThatSendsTheOriginToInfinityKeepsUnitMeanScaleAndExactCorners
   Eigen::Matrix4d H = Eigen::Matrix4d::Identity();
   H.col(3) = Eigen::Vector4d(2.5, 0.0, 0.0, 0.0);
   H(3, 0) = 0.1;
-  std::vector<Eigen::Vector3d> q;
-  for (const auto& x : p) {
-    const Eigen::RowVector4d h = hom(x) * H;
-    q.emplace_back(h.head<3>().transpose() / h[3]);
-  }
+  const std::vector<Eigen::Vector3d> q = imagesUnder(H, p);
   const ProjectiveFit fit = fitProjectiveMap(p, q);
   EXPECT_LT(fit.residual, 1e-12);
   EXPECT_NEAR(meanReciprocalScale(fit), 1.0, 1e-12);
