@@ -50,11 +50,12 @@ struct AdmmSettings {
   double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
   /// With relaxed bounds (RelaxedBounds: rows within eps of their centre, an eps schedule's
   /// attempt) the primal residual's absolute tolerance is at most this fraction of eps, but
-  /// not below 1e-12 (rounding; 0: absoluteTolerance alone). Below absoluteTolerance an attempt otherwise converged to rows
-  /// that may miss their bounds by more than eps itself, with an active set that tolerance
-  /// leaves open: the backends' polishes then chose different ones (a multires projection
-  /// with fits of unit mean scale, attempts at eps 5e-7 .. 1e-10: meshes 1.5e-6 of the
-  /// diagonal apart; with 0.1, within 1e-6).
+  /// not below 1e-12 (rounding); 0: absoluteTolerance alone. With eps below
+  /// absoluteTolerance, an attempt otherwise converged to rows that may miss their bounds
+  /// by more than eps itself, with an active set that tolerance leaves open: the backends'
+  /// polishes then chose different ones (a multires projection with fits of unit mean
+  /// scale, attempts at eps 5e-7 .. 1e-10: meshes 1.5e-6 of the diagonal apart; with 0.1,
+  /// within 1e-6).
   double epsilonToleranceFraction = 0.1;
   int maxIterations = 4000;
   int checkInterval = 10;                ///< Residuals and certificates every this many iterations.
