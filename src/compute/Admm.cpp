@@ -175,6 +175,9 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
     : kernels_(std::move(kernels)), n_(n), m_(m), settings_(settings), rho_(settings.rho) {
   if (settings_.checkInterval < 1) throwUsage("ADMM: checkInterval must be at least 1");
   if (settings_.stallIterations < 0) throwUsage("ADMM: stallIterations must be >= 0 (0: never stop as stalled)");
+  if (!(settings_.farDualFactor >= 0.0) || std::isinf(settings_.farDualFactor)) {
+    throwUsage("ADMM: farDualFactor must be a finite number >= 0 (0: never)");
+  }
   if (!(settings_.epsilonToleranceFraction >= 0.0) || std::isinf(settings_.epsilonToleranceFraction)) {
     throwUsage("ADMM: epsilonToleranceFraction must be a finite number >= 0 (0: absoluteTolerance alone)");
   }
@@ -464,8 +467,13 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     // 5 380 ADMM iterations.
     const bool settledInaccurate = info.dualResidual > dualTolerance && nearOptimal() &&
                                    tooSlowForTheCap(window.dual, info.dualResidual, dualTolerance);
+    // Far from optimal and as slow (AdmmSettings::farDualFactor).
+    const bool farAndSlow = settings_.farDualFactor > 0.0 &&
+                            info.dualResidual > settings_.farDualFactor * dualTolerance &&
+                            info.dualResidual < window.dual &&
+                            tooSlowForTheCap(window.dual, info.dualResidual, dualTolerance);
     window = {info.iterations, info.primalResidual, dy, dy, info.dualResidual};
-    return stuck || tooSlow || settledInaccurate;
+    return stuck || tooSlow || settledInaccurate || farAndSlow;
   };
 
   s = kernels_->measure();

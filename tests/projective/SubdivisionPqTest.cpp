@@ -134,6 +134,19 @@ TEST_F(SubdivisionPq, DodecahedronFourPointAttemptsTooSlowForTheCapStopEarly) {
   EXPECT_LT(admmIterations, 3000);
 }
 
+TEST_F(SubdivisionPq, AttemptsFarFromOptimalAndTooSlowForTheCapStopEarlyOnATwoRingDome) {
+  // Both levels have attempts whose dual residual, hundreds of times its tolerance, falls
+  // too slowly to meet it within the cap: they ran on (7 700 ADMM iterations over both
+  // levels, the same number of local/global iterations) until they stalled or hit the cap.
+  // They now stop at their first window that shows it (AdmmSettings::farDualFactor): 4 570.
+  const PqSubdivisionResult result = twoLevels(generate::hexagonalDome(2), SubdivisionScheme::FourPoint);
+  EXPECT_LE(result.info.totalIterations, 3);
+  for (const PqLevelInfo& level : result.info.levels) EXPECT_LT(level.planarity.max, 0.5) << "level " << level.level;
+  int admmIterations = 0;
+  for (const auto& [level, attempt] : attemptsOf(result)) admmIterations += attempt.iterations;
+  EXPECT_LT(admmIterations, 6000);
+}
+
 TEST_F(SubdivisionPq, TheCallbackSeesEveryIterationOfEveryLevelInOrder) {
   PqSubdivisionSettings settings;
   settings.levels = 2;
