@@ -363,13 +363,6 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
   std::vector<char> equality(m_);
   for (Eigen::Index i = 0; i < m_; ++i) equality[i] = (lower.row(i).array() == upper.row(i).array()).all();
   AdmmInfo info;
-  if (!factored_ || equality != factoredEquality_ || factoredRho_ != rho_) {
-    kernels_->setRho(equality, rho_);
-    factored_ = true;
-    factoredEquality_ = equality;
-    factoredRho_ = rho_;
-    ++info.factorizations;
-  }
   if (relaxed) {
     kernels_->startRelaxed(q, *relaxed, x, y);
   } else {
@@ -480,6 +473,16 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
   if (converged()) {
     info.status = AdmmStatus::Solved;
   } else {
+    // K is formed (on the CPU: factored) only for a start that needs iterations: a warm
+    // start that already meets the tolerances (targets compatible to rounding, e.g. the
+    // linear scheme's points of a translational surface) costs no factorization.
+    if (!factored_ || equality != factoredEquality_ || factoredRho_ != rho_) {
+      kernels_->setRho(equality, rho_);
+      factored_ = true;
+      factoredEquality_ = equality;
+      factoredRho_ = rho_;
+      ++info.factorizations;
+    }
     while (info.iterations < settings_.maxIterations) {
       // Between check blocks the iterate is consistent: an interruption loses nothing.
       throwIfCancelled("the ADMM iteration");

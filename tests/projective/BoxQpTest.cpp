@@ -259,6 +259,34 @@ TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
   EXPECT_GT(info.iterations, 0);
 }
 
+TEST(BoxQp, AnAdmmWarmStartThatMeetsTheTolerancesFactorsNothing) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 2, 13);
+  const Eigen::MatrixXd lower = qp.d.array() - 0.1, upper = qp.d.array() + 0.1;  // every row relaxed
+  compute::CpuBackend backend;
+  BoxQpSolver solved(backend, qp.P, qp.C);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo first = solved.solve(qp.q, lower, upper, x, y);
+  ASSERT_EQ(first.status, BoxQpStatus::Solved);
+  ASSERT_GT(first.iterations, 0);
+  EXPECT_GE(first.factorizations, 1);
+  // A new solver (nothing factored yet) started at that solution: converged at the first
+  // check, so K is never formed (on a 1M-face mesh, CHOLMOD's factorization of it alone took
+  // most of a PQ subdivision level whose targets were already compatible).
+  BoxQpSolver fresh(backend, qp.P, qp.C);
+  const Eigen::MatrixXd xSolved = x;
+  const BoxQpInfo again = fresh.solve(qp.q, lower, upper, x, y);
+  EXPECT_EQ(again.status, BoxQpStatus::Solved);
+  EXPECT_EQ(again.iterations, 0);
+  EXPECT_EQ(again.factorizations, 0);
+  EXPECT_LT((x - xSolved).cwiseAbs().maxCoeff(), 1e-12);
+  // A start that needs iterations still forms K.
+  Eigen::MatrixXd xCold, yCold;
+  const BoxQpInfo cold = fresh.solve(qp.q, lower, upper, xCold, yCold);
+  EXPECT_EQ(cold.status, BoxQpStatus::Solved);
+  EXPECT_GT(cold.iterations, 0);
+  EXPECT_GE(cold.factorizations, 1);
+}
+
 TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 10);
   compute::RelaxedBounds bounds{qp.d, std::vector<char>(5, 1), 0.05};
