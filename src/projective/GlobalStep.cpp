@@ -44,6 +44,9 @@ GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::
     throwUsage("global step: smoothness must be a finite number >= 0, got " + formatDouble(settings_.smoothness));
   }
   if (!(settings_.epsilonGrowth > 1.0)) throwUsage("global step: epsilon growth must exceed 1");
+  if (!(settings_.compatibleViolation >= 0.0) || !std::isfinite(settings_.compatibleViolation)) {
+    throwUsage("global step: the compatible violation must be a finite number >= 0");
+  }
   std::vector<Index> slot(space_.vertexCount(), -1);
   for (std::size_t i = 0; i < constrained_.size(); ++i) {
     const Index v = constrained_[i];
@@ -242,7 +245,9 @@ void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compu
   }
 
   std::vector<double> schedule;
-  const double eps0 = settings.initialEpsilonFraction * info.initialViolation;
+  const bool compatible =
+      settings.epsilonStart == EpsilonStart::Relaxed && info.initialViolation <= settings.compatibleViolation;
+  const double eps0 = (compatible ? 1.0 : settings.initialEpsilonFraction) * info.initialViolation;
   if (settings.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
   if (eps0 > 0.0) {
     double eps = eps0;

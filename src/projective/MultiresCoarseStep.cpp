@@ -42,6 +42,9 @@ MultiresCoarseStep::MultiresCoarseStep(compute::Backend& backend, const ShapeSpa
     throwUsage("coarse global step: smoothness must be a finite number >= 0, got " + number(settings_.smoothness));
   }
   if (!(settings_.epsilonGrowth > 1.0)) throwUsage("coarse global step: epsilon growth must exceed 1");
+  if (!(settings_.compatibleViolation >= 0.0) || !std::isfinite(settings_.compatibleViolation)) {
+    throwUsage("coarse global step: the compatible violation must be a finite number >= 0");
+  }
   std::vector<char> isFixed(space_.vertexCount(), 0);
   for (const Index v : fixed) {
     if (v < 0 || v >= space_.vertexCount()) {

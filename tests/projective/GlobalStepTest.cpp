@@ -30,9 +30,9 @@ double maxPlanarity(const Positions& vertices, const FaceList& faces) {
 
 /// Targets that disagree: the identity on half of the faces, a rotation about the
 /// z-axis on the others.
-std::vector<Eigen::Matrix4d> conflictingTargets(const ShapeSpace& space) {
+std::vector<Eigen::Matrix4d> conflictingTargets(const ShapeSpace& space, double angle = 0.2) {
   std::vector<Eigen::Matrix4d> targets(space.faceCount(), Eigen::Matrix4d::Identity());
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   for (Index f = 0; f < space.faceCount(); f += 2) targets[f].topLeftCorner<3, 3>() = R;
   return targets;
 }
@@ -107,6 +107,38 @@ TEST_F(GlobalStepTest, PositionalConstraintsHoldAndTheScheduleIsRecorded) {
   for (std::size_t i = 0; i < constrained.size(); ++i) {
     EXPECT_LT((p.row(constrained[i]) - at.row(i)).norm(), 1e-9 * space.normalization().scale) << "vertex " << constrained[i];
   }
+}
+
+TEST_F(GlobalStepTest, TargetsCompatibleToTheAdmmsToleranceAreKeptWithoutIterations) {
+  const ShapeSpace space(generate::translationalSurface(6, 6));
+  const std::vector<Eigen::Matrix4d> targets = conflictingTargets(space, 2e-8);
+  GlobalStep global(backend, space, {});
+  FaceMaps result;
+  const GlobalStepInfo info = global.solve(targets, Positions(), result);
+  ASSERT_GT(info.initialViolation, 0.0);
+  ASSERT_LE(info.initialViolation, GlobalStepSettings{}.compatibleViolation);
+  ASSERT_EQ(info.attempts.size(), 1u);
+  EXPECT_EQ(info.attempts.front().epsilon, info.initialViolation);
+  EXPECT_EQ(info.status, GlobalStepStatus::Unchanged);
+  EXPECT_EQ(info.admmIterations, 0);
+  EXPECT_EQ(maxMapDifference(result.maps, targets), 0.0);
+
+  // Without the rule the schedule starts at 1e-2 of the violation, which the ADMM must resolve.
+  GlobalStepSettings paper;
+  paper.compatibleViolation = 0.0;
+  GlobalStep strict(backend, space, {}, paper);
+  FaceMaps resolved;
+  const GlobalStepInfo strictInfo = strict.solve(targets, Positions(), resolved);
+  EXPECT_NEAR(strictInfo.attempts.front().epsilon, 1e-2 * strictInfo.initialViolation, 1e-22);
+  EXPECT_GT(strictInfo.admmIterations, 0);
+  EXPECT_LE(strictInfo.constraintResidual, strictInfo.epsilon * 1.1);
+}
+
+TEST_F(GlobalStepTest, ANegativeCompatibleViolationIsAUsageError) {
+  GlobalStepSettings settings;
+  settings.compatibleViolation = -1e-6;
+  const ShapeSpace space(generate::translationalSurface(3, 3));
+  EXPECT_THROW(GlobalStep(backend, space, {}, settings), Error);
 }
 
 TEST_F(GlobalStepTest, AnAttemptAfterAStalledOneStartsAtTheStalledOnesRho) {
