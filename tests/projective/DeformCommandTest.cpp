@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -65,6 +66,23 @@ TEST_F(DeformCommand, RefusesToOverwriteTheInputUnlessInPlace) {
   EXPECT_EQ(test::runTool(args).exitCode, 2);
   EXPECT_EQ(test::runTool(args + " --in-place").exitCode, 0);
   EXPECT_NEAR(readMesh(dir / "grid.obj").vertices(48, 2), 0.4, 1e-6);
+}
+
+TEST_F(DeformCommand, HandlesPullingAgainstEachOtherAreNamedWhenTheProjectionMovesFar) {
+  // A 10x10 translational grid whose first row is fixed and whose last row is asked to bend
+  // against its profile: every rigid step is infeasible at eps = 0, and the planar faces the
+  // projection phase then finds lie several diagonals away.
+  writeMesh(dir / "g10.obj", generate::translationalSurface(10, 10));
+  write("pull.json", R"({"fixed": [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10],
+                         "handles": [{"vertex": 110, "position": [1.0, 0.0, 0.5]},
+                                     {"vertex": 115, "position": [1.0, 0.5, -0.26]},
+                                     {"vertex": 120, "position": [1.0, 1.0, 0.5]}]})");
+  const auto r = test::runTool("deform " + path("g10.obj") + " --constraints " + path("pull.json") + " -o " +
+                               path("out.obj") + " --max-iterations 5 -q");
+  EXPECT_EQ(r.exitCode, 4) << r.err;
+  EXPECT_NE(r.err.find("the projection to planar faces then moved a vertex by"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("handles that pull against each other"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.obj"));
 }
 
 TEST_F(DeformCommand, IterationCapExitsWithFourAndWritesOnlyWithKeepPartial) {

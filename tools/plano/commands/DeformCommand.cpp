@@ -4,6 +4,7 @@
 // The command is split into option parsing, one function per deformation method (today:
 // the single-level projective deformation) and the common output/report handling, so that
 // another method is one more function and one more branch in `runMethod`.
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -77,14 +78,29 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
 std::string notConvergedReason(const projective::DeformationInfo& info,
                                const projective::DeformationSettings& settings) {
   double displacement = 0.0;
+  double projectionDisplacement = -1.0;  // largest move of a projection iteration; < 0: none ran
   for (const auto& it : info.history) {
-    if (it.phase == projective::DeformationPhase::Ideal) displacement = it.displacement;
+    if (it.phase == projective::DeformationPhase::Ideal) {
+      displacement = it.displacement;
+    } else {
+      projectionDisplacement = std::max(projectionDisplacement, it.displacement);
+    }
   }
   std::ostringstream reason;
   reason << std::setprecision(3) << "not converged after " << info.iterations
          << " iterations: the last rigid/similar one moved a vertex by " << displacement
          << " of the diagonal (tolerance " << settings.tolerance << "), max planarity " << info.planarity.max
          << "% (tolerance " << settings.planarityTolerance << "%)";
+  if (projectionDisplacement >= 0.0) {
+    reason << "; the projection to planar faces then moved a vertex by " << projectionDisplacement
+           << " of the diagonal";
+    // Planar faces that meet the constraints exist only far from the rigid/similar shape:
+    // a mesh whose faces the projection has to move by more than the whole bounding box.
+    if (projectionDisplacement > 1.0) {
+      reason << " (the constraints admit planar meshes only far from the rigid/similar shape: handles that "
+                "pull against each other?)";
+    }
+  }
   return reason.str();
 }
 
