@@ -497,7 +497,11 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
         info.status = AdmmStatus::NonFinite;
         break;
       }
-      if (converged()) {
+      const bool done = converged();
+      if (settings_.onCheck) {
+        settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
+      }
+      if (done) {
         info.status = AdmmStatus::Solved;
         break;
       }

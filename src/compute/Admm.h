@@ -40,6 +40,16 @@ enum class AdmmPreconditioner {
   Automatic,
 };
 
+/// The state of an ADMM solve at one of its convergence checks (AdmmSettings::onCheck).
+struct AdmmCheck {
+  int iterations = 0;            ///< ADMM iterations so far in this solve.
+  double primalResidual = 0.0;   ///< max ||C x - z||_inf over the columns.
+  double primalTolerance = 0.0;  ///< What the primal residual must reach.
+  double dualResidual = 0.0;     ///< max ||P x + q + C^T y||_inf over the columns.
+  double dualTolerance = 0.0;
+  double rho = 0.0;              ///< Of the inequality rows.
+};
+
 struct AdmmSettings {
   double rho = 0.1;                      ///< Initial penalty of inequality rows.
   double equalityRhoScale = 1e3;         ///< rho of rows with l = u, relative to rho.
@@ -97,6 +107,11 @@ struct AdmmSettings {
   /// residuals about one to one, so a small fraction keeps the iteration the host's.
   double linearToleranceFraction = 1e-2;
   LinearSolverSettings linearSolver;     ///< Of the solves with K (iterative backends).
+  /// Called at every convergence check after the first iterations (every checkInterval
+  /// iterations), on the calling thread; may be empty. For progress output: a global step on
+  /// a large mesh can run thousands of iterations between its caller's own reports. It may
+  /// throw Interrupted (the iterate is consistent at a check) and nothing else.
+  std::function<void(const AdmmCheck&)> onCheck;
   /// Rows per block of the iterative backends' block-Jacobi preconditioner of K (1 to 4;
   /// 1 is Jacobi): rows b i .. b i + b - 1 form block i, so n must be a multiple of b.
   /// Unknowns that K couples strongly in small groups (a face's map entries) converge in

@@ -287,6 +287,33 @@ TEST(BoxQp, AnAdmmWarmStartThatMeetsTheTolerancesFactorsNothing) {
   EXPECT_GE(cold.factorizations, 1);
 }
 
+TEST(BoxQp, TheAdmmReportsEachConvergenceCheckToItsCallback) {
+  const EqualityQp qp = consistentEqualityQp(12, 5, 2, 17);
+  const Eigen::MatrixXd lower = qp.d.array() - 0.1, upper = qp.d.array() + 0.1;
+  std::vector<compute::AdmmCheck> checks;
+  BoxQpSettings settings;
+  settings.polish = false;
+  settings.onCheck = [&](const compute::AdmmCheck& check) { checks.push_back(check); };
+  compute::CpuBackend backend;
+  BoxQpSolver solver(backend, qp.P, qp.C, settings);
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = solver.solve(qp.q, lower, upper, x, y);
+  ASSERT_EQ(info.status, BoxQpStatus::Solved);
+  ASSERT_GT(info.iterations, 0);
+  ASSERT_EQ(checks.size(), static_cast<std::size_t>(info.iterations / settings.checkInterval));
+  for (std::size_t i = 0; i < checks.size(); ++i) {
+    EXPECT_EQ(checks[i].iterations, static_cast<int>(i + 1) * settings.checkInterval);
+    EXPECT_GT(checks[i].primalTolerance, 0.0);
+    EXPECT_GT(checks[i].dualTolerance, 0.0);
+    EXPECT_GT(checks[i].rho, 0.0);
+  }
+  // The last check is the converged one, with the residuals the solve reports.
+  EXPECT_EQ(checks.back().primalResidual, info.primalResidual);
+  EXPECT_EQ(checks.back().dualResidual, info.dualResidual);
+  EXPECT_LE(checks.back().primalResidual, checks.back().primalTolerance);
+  EXPECT_LE(checks.back().dualResidual, checks.back().dualTolerance);
+}
+
 TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 10);
   compute::RelaxedBounds bounds{qp.d, std::vector<char>(5, 1), 0.05};

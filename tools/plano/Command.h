@@ -2,10 +2,12 @@
 // Sub-commands of the `plano` tool register themselves here, one file per command in
 // tools/plano/commands/, so that adding a command touches no other file.
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "compute/Admm.h"
 #include "compute/Backend.h"
 #include "subspace/LinearSpace.h"
 
@@ -68,5 +70,11 @@ void warnIfFacesAreNotPlanar(const std::string& command, const subspace::LinearS
 
 /// Progress line on stderr unless --quiet.
 void progress(const GlobalOptions& options, const std::string& message);
+
+/// For AdmmSettings::onCheck: unless --quiet, a line on stderr with the ADMM's iteration and
+/// residuals at most every `interval` (a global step on a large mesh can run minutes between
+/// its command's own per-iteration lines); empty with --quiet.
+std::function<void(const compute::AdmmCheck&)> admmHeartbeat(
+    const GlobalOptions& options, std::chrono::steady_clock::duration interval = std::chrono::seconds(10));
 
 }  // namespace plano::cli

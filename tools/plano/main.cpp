@@ -1,7 +1,10 @@
 // plano: command-line tool for polyhedral meshes. Each sub-command lives in
 // tools/plano/commands/ and registers itself (Command.h).
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
+#include <memory>
+#include <sstream>
 
 #include "core/Error.h"
 #include "plano/Command.h"
@@ -52,6 +55,22 @@ std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& op
 
 void progress(const GlobalOptions& options, const std::string& message) {
   if (!options.quiet) std::cerr << message << std::endl;
+}
+
+std::function<void(const compute::AdmmCheck&)> admmHeartbeat(const GlobalOptions& options,
+                                                              std::chrono::steady_clock::duration interval) {
+  if (options.quiet) return {};
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  return [last, interval](const compute::AdmmCheck& check) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - *last < interval) return;
+    *last = now;
+    std::ostringstream line;
+    line << std::setprecision(3) << "  ADMM iteration " << check.iterations << ": primal residual "
+         << check.primalResidual << " (tolerance " << check.primalTolerance << "), dual residual "
+         << check.dualResidual << " (tolerance " << check.dualTolerance << ")";
+    std::cerr << line.str() << std::endl;
+  };
 }
 
 }  // namespace plano::cli

@@ -112,6 +112,7 @@ DeformOutcome runSingleLevel(const DeformOptions& options, const GlobalOptions& 
   settings.maxIterations = options.maxIterations;
   settings.tolerance = options.tolerance;
   settings.planarityTolerance = options.planarityTolerance;
+  settings.global.qp.onCheck = admmHeartbeat(global);
 
   const auto callback = [&](const projective::DeformationIteration& it) {
     std::ostringstream line;
@@ -175,6 +176,7 @@ projective::PqSubdivisionResult rebuildHierarchy(const DeformOptions& options, c
   settings.scheme = projective::parseSubdivisionScheme(options.scheme);
   settings.levels = levels;
   settings.planarityTolerance = projective::isInterpolating(settings.scheme) ? 0.5 : 0.1;
+  settings.globalStep.qp.onCheck = admmHeartbeat(global);
   const auto hierarchyOnly = projective::SubdivisionHierarchy(base.faces, base.vertexCount(), levels);
   if (levels == 0 || !(hierarchyOnly.faces(levels) == mesh.faces)) {
     throwBadInput(options.input + " is not a subdivision of " + options.base + " (" +
@@ -205,6 +207,7 @@ DeformOutcome runMultires(const DeformOptions& options, const GlobalOptions& glo
   settings.maxCoarseIterations = options.maxIterations;
   settings.tolerance = options.tolerance;
   settings.planarityTolerance = options.planarityTolerance;
+  settings.global.qp.onCheck = admmHeartbeat(global);
   const auto callback = [&](const projective::MultiresIteration& it) {
     std::ostringstream line;
     line << std::setprecision(3) << "multires ";

@@ -37,7 +37,9 @@ RunFunction setup(CLI::App& app) {
     const PolygonMesh a = readMesh(options->first);
     const PolygonMesh b = readMesh(options->second);
     auto backend = makeBackend(global);
-    projective::Interpolation interpolation(*backend, a, b);
+    projective::InterpolationSettings settings;
+    settings.global.qp.onCheck = admmHeartbeat(global);
+    projective::Interpolation interpolation(*backend, a, b, settings);
     projective::GlobalStepInfo info;
     const PolygonMesh result = interpolation.at(options->t, &info);
     const PlanarityStats stats = planarityStats(result);

@@ -109,8 +109,10 @@ RunFunction setup(CLI::App& app) {
       prescription.strength = options->strength;
       prescription.pivot = pivot;
       prescription.point = Eigen::Vector3d(options->point[0], options->point[1], options->point[2]);
+      projective::PrescriptionSettings settings;
+      settings.global.qp.onCheck = admmHeartbeat(global);
       const projective::PrescriptionResult r =
-          projective::prescribeMaps(*backend, mesh, prescription, options->faces, constraints);
+          projective::prescribeMaps(*backend, mesh, prescription, options->faces, constraints, settings);
       result = r.mesh;
       steps.push_back(stepJson(r.info));
       for (const auto& step : r.projection) steps.push_back(stepJson(step));

@@ -90,6 +90,7 @@ RunFunction setup(CLI::App& app) {
         options->tolerance > 0.0 ? options->tolerance : (projective::isInterpolating(settings.scheme) ? 0.5 : 0.1);
     settings.maxIterationsPerLevel = options->maxIterations;
     settings.planarize = !options->linear;
+    settings.globalStep.qp.onCheck = admmHeartbeat(global);
     // One line per local/global iteration: a level of a large mesh runs for minutes.
     const auto callback = [&](int level, int iteration, const projective::PqIteration& it) {
       std::ostringstream line;
