@@ -47,6 +47,7 @@ GlobalStep::GlobalStep(compute::Backend& backend, const ShapeSpace& space, std::
   if (!(settings_.compatibleViolation >= 0.0) || !std::isfinite(settings_.compatibleViolation)) {
     throwUsage("global step: the compatible violation must be a finite number >= 0");
   }
+  setIntermediateAttempts(settings_.intermediateAttempts);
   std::vector<Index> slot(space_.vertexCount(), -1);
   for (std::size_t i = 0; i < constrained_.size(); ++i) {
     const Index v = constrained_[i];
@@ -161,6 +162,11 @@ GlobalStepInfo GlobalStep::solveProjectiveFitsAt(const compute::DeviceMatrix& cu
   return solve(fits, positions, resultColumns);
 }
 
+void GlobalStep::setIntermediateAttempts(int attempts) {
+  if (attempts < 0) throwUsage("global step: the intermediate attempts must be >= 0, got " + std::to_string(attempts));
+  settings_.intermediateAttempts = attempts;
+}
+
 GlobalStepInfo GlobalStep::solveAffine(const compute::DeviceMatrix& linearColumns, const Positions& positions,
                                        FaceMaps& result) {
   compute::DeviceMatrix columns;
@@ -251,7 +257,16 @@ void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compu
   if (settings.epsilonStart == EpsilonStart::ExactFirst || eps0 == 0.0) schedule.push_back(0.0);
   if (eps0 > 0.0) {
     double eps = eps0;
-    for (int i = 0; i <= settings.maxEpsilonIncreases; ++i, eps *= settings.epsilonGrowth) schedule.push_back(eps);
+    for (int i = 0; i <= settings.maxEpsilonIncreases; ++i, eps *= settings.epsilonGrowth) {
+      const bool keepsTargets = eps >= (1.0 - 1e-12) * info.initialViolation;  // eps0 * growth^i rounds
+      if (keepsTargets && i > 0 && schedule.back() < (1.0 - 1e-12) * info.initialViolation) {
+        // The last eps below the violation: intermediate attempts before keeping the targets.
+        const double failed = schedule.back();
+        const int n = settings.intermediateAttempts;
+        for (int j = 1; j <= n; ++j) schedule.push_back(failed * std::pow(settings.epsilonGrowth, double(j) / (n + 1)));
+      }
+      schedule.push_back(eps);
+    }
   }
 
   bool solved = false;

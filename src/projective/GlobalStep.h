@@ -60,6 +60,12 @@ struct GlobalStepSettings {
   /// of the cube's hierarchy took 1 160 ADMM iterations and 221 s on the CPU for faces
   /// already planar to 0.02 %. 0: every schedule starts at the paper's fraction.
   double compatibleViolation = 1e-6;
+  /// Attempts tried between the last failed eps below the targets' violation and the
+  /// schedule's next eps, when that one is at least the violation: the targets meet such an
+  /// eps, so the step would keep them and make no progress. n attempts split that factor
+  /// geometrically (n = 2 and growth 10: 10^(1/3) and 10^(2/3) times the failed eps).
+  /// 0: the paper's schedule alone.
+  int intermediateAttempts = 0;
   /// The QP's settings. On an iterative backend the inner solves with K of more than 64
   /// faces use the aggregation multigrid over faces (compute/BlockMultigrid.h): several
   /// times fewer PCG iterations than face blocks, and the host's ADMM iteration kept where
@@ -152,6 +158,8 @@ class GlobalStep {
 
   const std::vector<Index>& constrainedVertices() const { return constrained_; }
   const GlobalStepSettings& settings() const { return settings_; }
+  /// GlobalStepSettings::intermediateAttempts for the following steps.
+  void setIntermediateAttempts(int attempts);
 
  private:
   /// One row of C_s: corner a's face minus corner b's face (b < 0: positional row).

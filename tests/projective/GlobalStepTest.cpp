@@ -134,6 +134,39 @@ TEST_F(GlobalStepTest, TargetsCompatibleToTheAdmmsToleranceAreKeptWithoutIterati
   EXPECT_LE(strictInfo.constraintResidual, strictInfo.epsilon * 1.1);
 }
 
+TEST_F(GlobalStepTest, IntermediateAttemptsComeBeforeTheEpsilonThatKeepsTheTargets) {
+  // Attempts capped after 10 ADMM iterations fail below the targets' violation; the
+  // schedule's third eps, the violation itself, keeps the targets.
+  const ShapeSpace space(generate::translationalSurface(6, 6));
+  const std::vector<Eigen::Matrix4d> targets = conflictingTargets(space);
+  GlobalStepSettings settings;
+  settings.qp.maxIterations = 10;
+  const auto epsilonsOf = [&](int intermediate) {
+    settings.intermediateAttempts = intermediate;
+    GlobalStep global(backend, space, {}, settings);
+    FaceMaps result;
+    const GlobalStepInfo info = global.solve(targets, Positions(), result);
+    EXPECT_EQ(info.status, GlobalStepStatus::Unchanged);
+    EXPECT_EQ(maxMapDifference(result.maps, targets), 0.0);
+    std::vector<double> relative;
+    for (const EpsilonAttempt& attempt : info.attempts) relative.push_back(attempt.epsilon / info.initialViolation);
+    return relative;
+  };
+  const std::vector<double> paper = epsilonsOf(0);
+  ASSERT_EQ(paper.size(), 3u);
+  EXPECT_NEAR(paper[1], 0.1, 1e-12);
+  const std::vector<double> refined = epsilonsOf(3);
+  ASSERT_EQ(refined.size(), 6u);
+  for (int j = 1; j <= 3; ++j) EXPECT_NEAR(refined[1 + j], 0.1 * std::pow(10.0, j / 4.0), 1e-12) << j;
+  EXPECT_NEAR(refined.back(), 1.0, 1e-12);
+
+  // Set on a step object, and rejected when negative.
+  GlobalStep global(backend, space, {}, settings);
+  EXPECT_THROW(global.setIntermediateAttempts(-1), Error);
+  settings.intermediateAttempts = -1;
+  EXPECT_THROW(GlobalStep(backend, space, {}, settings), Error);
+}
+
 TEST_F(GlobalStepTest, ANegativeCompatibleViolationIsAUsageError) {
   GlobalStepSettings settings;
   settings.compatibleViolation = -1e-6;
