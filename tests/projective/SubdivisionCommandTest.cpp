@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -95,6 +96,20 @@ TEST(SubdivisionCommand, ReportsUsageAndInputErrorsWithTheirExitCodes) {
   const auto missing = test::runTool("subdivide " + (dir / "missing.obj").string() + " -o " + (dir / "out.obj").string());
   EXPECT_EQ(missing.exitCode, 3) << missing.err;
   EXPECT_NE(missing.err.find("missing.obj"), std::string::npos) << missing.err;
+}
+
+TEST(SubdivisionCommand, ANonPlanarInputIsBadInputAndWritesNothing) {
+  test::TempDir dir;
+  writeMesh(dir / "hypar.obj", generate::hyparGrid(4, 0.5));
+  const auto result =
+      test::runTool("subdivide " + (dir / "hypar.obj").string() + " -o " + (dir / "fine.obj").string() + " --keep-partial");
+  EXPECT_EQ(result.exitCode, 3) << result.err;
+  EXPECT_NE(result.err.find("not planar enough"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "fine.obj"));
+  // The linear scheme takes it.
+  EXPECT_EQ(test::runTool("-q subdivide " + (dir / "hypar.obj").string() + " -o " + (dir / "fine.obj").string() +
+                          " --linear").exitCode,
+            0);
 }
 
 }  // namespace

@@ -3,8 +3,10 @@
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
 #include "mesh/Generators.h"
+#include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "projective/PqSubdivision.h"
+#include "support/TestMeshes.h"
 
 namespace plano::projective {
 namespace {
@@ -230,6 +232,53 @@ TEST_F(SubdivisionPq, LinearOnlySettingReturnsTheLinearScheme) {
   EXPECT_EQ(result.info.totalIterations, 0);
   EXPECT_EQ(result.positions.back(), linearOnly(cube, SubdivisionScheme::CatmullClark, 2));
   EXPECT_NEAR(result.info.levels[0].planarity.max, 4.43, 0.006);
+}
+
+TEST_F(SubdivisionPq, AnInputTooNonPlanarForTheBoundIsRejectedNamingItsWorstFace) {
+  // Every face of a level is a projective image of its base face: from faces 2.6 % non-planar
+  // after the trivial refinement no iteration reached 0.1 % (20 iterations at 2.65 %).
+  const PolygonMesh hypar = generate::hyparGrid(4, 0.5);
+  PqSubdivisionSettings settings;
+  settings.maxIterationsPerLevel = 1;
+  try {
+    subdividePlanarQuads(backend, hypar, settings);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput);
+    const std::string message = e.what();
+    EXPECT_NE(message.find("not planar enough"), std::string::npos) << message;
+    EXPECT_NE(message.find("input face"), std::string::npos) << message;
+  }
+  // The linear scheme alone, and a bound above the base's planarity, take it.
+  settings.planarize = false;
+  EXPECT_NO_THROW(subdividePlanarQuads(backend, hypar, settings));
+  settings.planarize = true;
+  settings.planarityTolerance = 50.0;
+  EXPECT_NO_THROW(subdividePlanarQuads(backend, hypar, settings));
+}
+
+TEST_F(SubdivisionPq, ALevelWhoseScheduleKeptItsTargetsGoesOnWithIntermediateAttempts) {
+  PLANO_REQUIRE_SHARED_MESH(path, "double_torus_quads.off");
+  const PolygonMesh torus = readMesh(path.string());
+  PqSubdivisionSettings settings;
+  settings.intermediateAttempts = 0;  // the paper's schedule: 0.185 % after 20 iterations
+  settings.maxIterationsPerLevel = 12;
+  const PqSubdivisionResult paper = subdividePlanarQuads(backend, torus, settings);
+  EXPECT_EQ(paper.info.status, PqSubdivisionStatus::IterationLimit);
+  EXPECT_GT(paper.info.levels[0].planarity.max, 0.15);
+  for (const PqIteration& it : paper.info.levels[0].iterations) EXPECT_LE(it.attempts.size(), 3u);
+
+  settings.intermediateAttempts = 3;
+  const PqSubdivisionResult refined = subdividePlanarQuads(backend, torus, settings);
+  EXPECT_EQ(refined.info.status, PqSubdivisionStatus::Converged);
+  EXPECT_LE(refined.info.levels[0].planarity.max, 0.1);
+  EXPECT_LT(refined.info.levels[0].distanceToLinear, 0.03);
+  std::size_t attempts = 0;
+  for (const PqIteration& it : refined.info.levels[0].iterations) attempts = std::max(attempts, it.attempts.size());
+  EXPECT_GE(attempts, 4u);  // some step went past the paper's three
+
+  settings.intermediateAttempts = -1;
+  EXPECT_THROW(subdividePlanarQuads(backend, torus, settings), Error);
 }
 
 TEST_F(SubdivisionPq, ZeroLevelsReturnTheInputAndBadSettingsAreRejected) {
