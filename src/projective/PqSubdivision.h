@@ -39,9 +39,9 @@ struct PqSubdivisionSettings {
   /// times 10) made no progress, and the refits alone no longer do. On the double torus
   /// (136 quads, 5.4 % linear) the level crept from 0.23 % to 0.185 % over 20 iterations;
   /// with 3 intermediate eps it reaches 0.1 % in 9. Levels whose schedules progress, or
-  /// whose refits still flatten, are unaffected (the intermediate attempts cost ADMM
-  /// iterations: 3-5x on the Enneper hexagons, which end above the bound either way).
-  /// 0: never.
+  /// whose refits still flatten, are unaffected: intermediate attempts cost ADMM
+  /// iterations (from the first kept targets on, 2-4.5x on the Enneper hexagons, which
+  /// end above the bound either way; with the 5 % condition 18 % more). 0: never.
   int intermediateAttempts = 3;
   GlobalStepSettings globalStep;
 };
