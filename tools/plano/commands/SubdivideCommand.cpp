@@ -68,7 +68,8 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 12));
   app.add_option("--tolerance", options->tolerance,
-                 "Max planarity in percent (default 0.1 for catmull-clark, 0.5 for four-point)")
+                 "Max planarity in percent (default 0.1 for catmull-clark, 0.5 for four-point); "
+                 "the input's trivially refined faces must meet it")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-iterations", options->maxIterations, "Local/global iterations per level at most")
       ->capture_default_str()
