@@ -1395,6 +1395,34 @@ TEST_F(VulkanAdmm, TheDevicesAdmmGivesTheMapsTheCpuSolvesDirectly) {
   EXPECT_LT(both.mapDifference(), 1e-10);  // measured 1.1e-11 on lavapipe (8.0e-12 before the rounding floor)
 }
 
+TEST_F(VulkanAdmm, IntermediateAttemptsGiveTheCpusEpsilonScheduleOnTheDevice) {
+  // The paper's schedule from the targets' violation, every attempt capped at 10 ADMM
+  // iterations: the attempts at 1e-2 and 1e-1 of the violation fail, then three
+  // intermediate eps between 1e-1 and 1 (GlobalStepSettings::intermediateAttempts) fail
+  // too before the violation itself keeps the targets. The host decides the schedule from
+  // what each attempt reports, so the device must report what the CPU's attempts do.
+  GlobalStepCase problem(6);
+  problem.fixed.clear();
+  problem.at.resize(0, 3);
+  problem.settings = projective::GlobalStepSettings{};
+  problem.settings.qp.maxIterations = 10;
+  problem.settings.intermediateAttempts = 3;
+  const BothBackends both = solveOnBothBackends(problem, backend());
+  EXPECT_EQ(both.hostInfo.status, projective::GlobalStepStatus::Unchanged);
+  EXPECT_EQ(both.deviceInfo.status, both.hostInfo.status);
+  ASSERT_EQ(both.hostInfo.attempts.size(), 6u);
+  ASSERT_EQ(both.deviceInfo.attempts.size(), both.hostInfo.attempts.size());
+  for (std::size_t a = 0; a < both.hostInfo.attempts.size(); ++a) {
+    const projective::EpsilonAttempt& host = both.hostInfo.attempts[a];
+    const projective::EpsilonAttempt& device = both.deviceInfo.attempts[a];
+    EXPECT_NEAR(device.epsilon, host.epsilon, 1e-12 * host.epsilon) << "attempt " << a;
+    EXPECT_EQ(device.status, host.status) << "attempt " << a;
+    EXPECT_EQ(device.iterations, host.iterations) << "attempt " << a;
+  }
+  EXPECT_NEAR(both.hostInfo.attempts[3].epsilon / both.hostInfo.initialViolation, 0.1 * std::pow(10.0, 0.5), 1e-12);
+  EXPECT_EQ(both.mapDifference(), 0.0);  // both keep the targets
+}
+
 TEST_F(VulkanAdmm, AGlobalStepWithoutConstraintRowsKeepsItsTargetsWithoutValidationMessages) {
   // A lone face and no constrained vertex: C has no rows, the device vectors of the rows
   // are empty (a zero-sized copy is a validation error), twice (the kept solver).
