@@ -215,10 +215,7 @@ Info GuidedProjectionPlanarizer::solve(Positions& vertices) {
   const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
   detail::GuidedProjectionWorkspace& ws = *workspace_;
-  Positions Y = detail::toNormalized(problem, vertices);
-  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-    if (problem.freeIndex[v] < 0) Y.row(v) = problem.input.row(v);
-  }
+  Positions Y = detail::startingPoint(problem, vertices);
   Info info;
   detail::Monitor monitor(problem, *backend_, settings_.tolerance);
   bool converged = monitor.record(Y, info);

@@ -112,6 +112,14 @@ Positions toNormalized(const Problem& problem, const Positions& original) {
   return result;
 }
 
+Positions startingPoint(const Problem& problem, const Positions& vertices) {
+  Positions start = toNormalized(problem, vertices);
+  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
+    if (problem.freeIndex[v] < 0) start.row(v) = problem.input.row(v);
+  }
+  return start;
+}
+
 void measureDisplacement(const Problem& problem, const Positions& normalized, Info& info) {
   info.maxDisplacement = 0.0;
   info.meanDisplacement = 0.0;

@@ -47,6 +47,10 @@ FacePlane bestFitPlane(const Positions& vertices, std::span<const Index> face);
 Positions toOriginal(const Problem& problem, const Positions& normalized);
 Positions toNormalized(const Problem& problem, const Positions& original);
 
+/// The common start of every planarizer's solve: `vertices` (the caller's initial guess)
+/// normalized, with the fixed vertices at their input positions whatever the guess says.
+Positions startingPoint(const Problem& problem, const Positions& vertices);
+
 /// Max and mean vertex displacement from the input, over the input's bounding-box diagonal.
 void measureDisplacement(const Problem& problem, const Positions& normalized, Info& info);
 

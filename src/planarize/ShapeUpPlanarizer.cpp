@@ -21,10 +21,7 @@ ShapeUpPlanarizer::~ShapeUpPlanarizer() = default;
 Info ShapeUpPlanarizer::solve(Positions& vertices) {
   const auto start = SteadyClock::now();
   const detail::Problem& problem = *problem_;
-  Positions Y = detail::toNormalized(problem, vertices);
-  for (Index v = 0; v < static_cast<Index>(problem.freeIndex.size()); ++v) {
-    if (problem.freeIndex[v] < 0) Y.row(v) = problem.input.row(v);
-  }
+  Positions Y = detail::startingPoint(problem, vertices);
   Info info;
   detail::Monitor monitor(problem, *backend_, settings_.tolerance);
   bool converged = monitor.record(Y, info);
