@@ -194,21 +194,7 @@ std::string formatOff(const PolygonMesh& mesh) {
   out += ' ';
   appendInteger(out, mesh.faceCount());
   out += " 0\n";
-  for (Index v = 0; v < mesh.vertexCount(); ++v) {
-    for (int a = 0; a < 3; ++a) {
-      if (a) out += ' ';
-      appendDouble(out, mesh.vertices(v, a));
-    }
-    out += '\n';
-  }
-  for (Index f = 0; f < mesh.faceCount(); ++f) {
-    appendInteger(out, mesh.faces.degree(f));
-    for (Index v : mesh.faces[f]) {
-      out += ' ';
-      appendInteger(out, v);
-    }
-    out += '\n';
-  }
+  appendVertexAndFaceLines(out, mesh);
   return out;
 }
 
