@@ -171,5 +171,31 @@ TEST(SubspaceDeform, DeformsInsideTheSpaceAndReportsIterations) {
   EXPECT_EQ(bad.exitCode, 3);
 }
 
+TEST(SubspaceDeform, TheUpVectorChoosesTheVerticalSpaceAndNeedsASpace) {
+  // --up is the vertical direction of `deform --space vertical` as of the other linear-space
+  // commands: the flat 6x6 grid in z = 0 has more vertical meshes for up = y than for up = z,
+  // where every face is horizontal. Without --space it chooses nothing and is refused.
+  TempDir dir;
+  writeMesh(dir / "grid.obj", generate::translationalSurface(6, 6));
+  {
+    std::ofstream(dir / "c.json") << R"({"fixed": [0, 1, 2, 3, 4, 5, 6],
+                                        "handles": [{"vertex": 48, "position": [6.0, 6.0, 1.0]}]})";
+  }
+  const std::string common = "-q deform " + quoted(dir / "grid.obj") + " --constraints " + quoted(dir / "c.json") +
+                             " -o " + quoted(dir / "out.obj");
+  const auto dimensionFor = [&](const std::string& up) {
+    const auto result = runTool(common + " --space vertical --report " + quoted(dir / "r.json") + up);
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    return result.exitCode == 0 ? readJson(dir / "r.json")["dimension"].get<int>() : -1;
+  };
+  const int alongZ = dimensionFor("");
+  EXPECT_EQ(dimensionFor(" --up 0,0,1"), alongZ);
+  EXPECT_GT(dimensionFor(" --up 0,1,0"), alongZ);
+  const auto withoutSpace = runTool(common + " --up 0,1,0");
+  EXPECT_EQ(withoutSpace.exitCode, 2);
+  EXPECT_NE(withoutSpace.err.find("need --space"), std::string::npos) << withoutSpace.err;
+  EXPECT_EQ(runTool(common + " --space vertical --up 0,0,0").exitCode, 2);
+}
+
 }  // namespace
 }  // namespace plano::test

@@ -15,6 +15,7 @@
 #include "mesh/MeshIO.h"
 #include "plano/Command.h"
 #include "plano/CommandOutcome.h"
+#include "plano/LinearSpaceOptions.h"
 #include "plano/Report.h"
 #include "plano/commands/SubspaceDeform.h"
 #include "projective/Deformation.h"
@@ -42,11 +43,11 @@ struct DeformOptions {
   std::string scheme = "catmull-clark";
   int multiresLevel = -1;
   // --space (linear-spaces paper §3): deformation inside a linear space of polyhedral meshes.
-  std::string space;
-  std::string facesFile;
+  LinearSpaceOptions linearSpace = {.space = ""};  ///< --space not given: the projective shape space.
   const CLI::Option* smoothnessOption = nullptr;  ///< Tells whether --smoothness was given.
   const CLI::Option* toleranceOption = nullptr;   ///< Tells whether --tolerance was given.
   const CLI::Option* maxIterationsOption = nullptr;
+  const CLI::Option* upOption = nullptr;  ///< Tells whether --up was given.
 };
 
 /// What a deformation method hands back to the common output code.
@@ -314,22 +315,24 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--multires-level", options->multiresLevel,
                  "With --multires: deform on this level instead of the automatic choice");
   // Deformation inside a linear space (linear-spaces paper §3, Fig. 8).
-  app.add_option("--space", options->space,
-                 "Deform inside a linear space of polyhedral meshes instead of the projective shape space "
-                 "(ASAP for --energy similar, ARAP for rigid)")
-      ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}));
-  app.add_option("--faces-file", options->facesFile, "With --space mixed: per-face space types");
+  addLinearSpaceOptions(app, options->linearSpace,
+                        "Deform inside a linear space of polyhedral meshes instead of the projective shape space "
+                        "(ASAP for --energy similar, ARAP for rigid): affine | parallel | vertical | mixed");
   options->smoothnessOption = app.get_option("--smoothness");
   options->toleranceOption = app.get_option("--tolerance");
   options->maxIterationsOption = app.get_option("--max-iterations");
+  options->upOption = app.get_option("--up");
   return [options](const GlobalOptions& global) {
-    if (!options->space.empty()) {
+    if (options->linearSpace.space.empty() &&
+        (options->upOption->count() > 0 || !options->linearSpace.facesFile.empty())) {
+      throwUsage("deform: --up and --faces-file choose a linear space and need --space");
+    }
+    if (!options->linearSpace.space.empty()) {
       if (options->multires) throwUsage("deform: --space and --multires cannot be combined");
       SubspaceDeformRequest request;
       request.mesh = options->input;
       request.constraints = options->constraints;
-      request.space = options->space;
-      request.facesFile = options->facesFile;
+      request.linearSpace = options->linearSpace;
       request.energy = options->energy == "similar" ? "asap" : "arap";
       request.output = options->output;
       request.report = options->report;

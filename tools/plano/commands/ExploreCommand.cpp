@@ -8,9 +8,9 @@
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
 #include "plano/CommandOutcome.h"
+#include "plano/LinearSpaceOptions.h"
 #include "plano/Report.h"
 #include "subspace/Eigenshapes.h"
-#include "subspace/FaceAssignmentIO.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/MeshLaplacian.h"
 
@@ -21,9 +21,7 @@ using namespace plano::subspace;
 
 struct ExploreOptions {
   std::string input, output, report;
-  std::string space = "affine";
-  std::string facesFile;
-  std::vector<double> up{0.0, 0.0, 1.0};
+  LinearSpaceOptions linearSpace;
   Index eigenshapes = 10;
   std::string band;
   double amplitude = 0.05;
@@ -44,11 +42,7 @@ std::pair<Index, Index> parseBand(const std::string& text, Index count) {
 RunFunction setup(CLI::App& app) {
   auto o = std::make_shared<ExploreOptions>();
   app.add_option("mesh", o->input, "Polyhedral mesh")->required();
-  app.add_option("--space", o->space, "affine | parallel | vertical | mixed")
-      ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}))
-      ->capture_default_str();
-  app.add_option("--faces-file", o->facesFile, "Per-face types for --space mixed");
-  app.add_option("--up", o->up, "Up vector of the vertical case, X,Y,Z")->delimiter(',')->expected(3);
+  addLinearSpaceOptions(app, o->linearSpace);
   app.add_option("--eigenshapes", o->eigenshapes, "Number of eigenshapes to compute")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -62,12 +56,11 @@ RunFunction setup(CLI::App& app) {
     const auto backend = makeLinearSpaceBackend(global, "explore", "the reduced operator runs");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
-    LinearSpaceSettings settings;
-    settings.constraints.up = Eigen::Vector3d(o->up[0], o->up[1], o->up[2]);
+    LinearSpaceSettings settings = o->linearSpace.settings();
     const LinearSpace space =
-        buildLinearSpace(mesh, requestedAssignment(o->space, o->facesFile, mesh.faceCount()), settings);
+        buildLinearSpace(mesh, o->linearSpace.assignment(mesh.faceCount()), settings);
     warnIfFacesAreNotPlanar("explore", space);
-    progress(global, o->space + " space: dimension " + std::to_string(space.dof.dimension));
+    progress(global, o->linearSpace.space + " space: dimension " + std::to_string(space.dof.dimension));
     EigenshapeSettings es;
     es.count = o->eigenshapes;
     EigenshapeInfo info;
@@ -78,7 +71,7 @@ RunFunction setup(CLI::App& app) {
     const PlanarityStats stats = planarityStats(out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json j = baseReport("explore", backend->name(), out, stats, seconds);
-    j["space"] = o->space;
+    j["space"] = o->linearSpace.space;
     j["dimension"] = space.dof.dimension;
     j["eigenshapes"] = shapes.count();
     j["frequencies"] = std::vector<double>(shapes.frequencies.data(), shapes.frequencies.data() + shapes.count());
@@ -87,7 +80,7 @@ RunFunction setup(CLI::App& app) {
     j["eigensolver"] = info.dense ? "dense" : "spectra";
     j["subspace_residual"] = space.B.residual(out.vertices) / out.vertices.norm();
     finishCommand("explore", CommandOutcome{}, o->keepPartial, {{o->output, &out}}, j, o->report);
-    std::cout << "added eigenshapes " << lo << ":" << hi << " of " << shapes.count() << " (" << o->space
+    std::cout << "added eigenshapes " << lo << ":" << hi << " of " << shapes.count() << " (" << o->linearSpace.space
               << " space, dimension " << space.dof.dimension << "), max planarity " << stats.max << "% -> "
               << o->output << "\n";
     return 0;

@@ -8,8 +8,8 @@
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
 #include "plano/CommandOutcome.h"
+#include "plano/LinearSpaceOptions.h"
 #include "plano/Report.h"
-#include "subspace/FaceAssignmentIO.h"
 #include "subspace/FundamentalShapes.h"
 #include "subspace/LinearSpace.h"
 #include "subspace/MeshLaplacian.h"
@@ -23,9 +23,7 @@ using namespace plano::subspace;
 
 struct ShapesOptions {
   std::string input, output, report;
-  std::string space = "affine";
-  std::string facesFile;
-  std::vector<double> up{0.0, 0.0, 1.0};
+  LinearSpaceOptions linearSpace;
   std::string kind = "fundamental";
   Index vertex = 0;
   std::vector<double> direction;
@@ -38,11 +36,7 @@ struct ShapesOptions {
 RunFunction setup(CLI::App& app) {
   auto o = std::make_shared<ShapesOptions>();
   app.add_option("mesh", o->input, "Polyhedral mesh")->required();
-  app.add_option("--space", o->space, "affine | parallel | vertical | mixed")
-      ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}))
-      ->capture_default_str();
-  app.add_option("--faces-file", o->facesFile, "Per-face types for --space mixed");
-  app.add_option("--up", o->up, "Up vector of the vertical case, X,Y,Z")->delimiter(',')->expected(3);
+  addLinearSpaceOptions(app, o->linearSpace);
   app.add_option("--kind", o->kind, "sparse | fundamental")
       ->check(CLI::IsMember({"sparse", "fundamental"}))
       ->capture_default_str();
@@ -72,9 +66,8 @@ RunFunction setup(CLI::App& app) {
     const Eigen::Vector3d direction = o->direction.size() == 3
                                           ? Eigen::Vector3d(o->direction[0], o->direction[1], o->direction[2])
                                           : vertexNormal(mesh, o->vertex);
-    LinearSpaceSettings settings;
-    settings.constraints.up = Eigen::Vector3d(o->up[0], o->up[1], o->up[2]);
-    const auto spaces = requestedAssignment(o->space, o->facesFile, mesh.faceCount());
+    LinearSpaceSettings settings = o->linearSpace.settings();
+    const auto spaces = o->linearSpace.assignment(mesh.faceCount());
     nlohmann::json extra;
     Positions shape;
     Positions base = mesh.vertices;
@@ -100,7 +93,7 @@ RunFunction setup(CLI::App& app) {
       shape = fundamentalShape(*backend, space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), o->vertex, direction, fs);
       base = space.N.project(mesh.vertices);
       extra = {{"dimension", space.dof.dimension}, {"smoothness", o->smoothness}};
-      std::cout << "fundamental shape of vertex " << o->vertex << " in the " << o->space << " space (dimension "
+      std::cout << "fundamental shape of vertex " << o->vertex << " in the " << o->linearSpace.space << " space (dimension "
                 << space.dof.dimension << ")\n";
     }
     const double peak = shape.rowwise().norm().maxCoeff();
@@ -108,7 +101,7 @@ RunFunction setup(CLI::App& app) {
     out.vertices = base + (peak > 0.0 ? o->amplitude * boundingBoxDiagonal(mesh.vertices) / peak : 0.0) * shape;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json j = baseReport("shapes", backendName, out, planarityStats(out), seconds);
-    j["space"] = o->space;
+    j["space"] = o->linearSpace.space;
     j["kind"] = o->kind;
     j["vertex"] = o->vertex;
     j["direction"] = {direction[0], direction[1], direction[2]};

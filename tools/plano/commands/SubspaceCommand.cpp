@@ -7,8 +7,8 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/LinearSpaceOptions.h"
 #include "plano/Report.h"
-#include "subspace/FaceAssignmentIO.h"
 #include "subspace/NonMaximalFaces.h"
 #include "subspace/SubspaceTopology.h"
 
@@ -19,9 +19,7 @@ using namespace plano::subspace;
 
 struct SubspaceOptions {
   std::string input;
-  std::string space = "affine";
-  std::string facesFile;
-  std::vector<double> up{0.0, 0.0, 1.0};
+  LinearSpaceOptions linearSpace;
   bool reassign = false;
   double rankTolerance = 1e-9;
   std::string report;
@@ -36,11 +34,7 @@ nlohmann::json typeCounts(const std::vector<FaceSpace>& spaces) {
 RunFunction setup(CLI::App& app) {
   auto o = std::make_shared<SubspaceOptions>();
   app.add_option("mesh", o->input, "Polyhedral mesh (.obj, .off, .ply)")->required();
-  app.add_option("--space", o->space, "affine | parallel | vertical | mixed")
-      ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}))
-      ->capture_default_str();
-  app.add_option("--faces-file", o->facesFile, "Per-face types for --space mixed (one word per face)");
-  app.add_option("--up", o->up, "Up vector of the vertical case, X,Y,Z")->delimiter(',')->expected(3);
+  addLinearSpaceOptions(app, o->linearSpace);
   app.add_flag("--reassign", o->reassign, "Reassign faces whose space is not maximal (Fig. 4) before reporting");
   app.add_option("--rank-tolerance", o->rankTolerance, "Relative rank tolerance of B")->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
@@ -49,10 +43,9 @@ RunFunction setup(CLI::App& app) {
         warnComputesOnCpu(global, "subspace", "its factorizations of B (SPQR, dense SVD) have no Vulkan kernels");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
-    LinearSpaceSettings settings;
-    settings.constraints.up = Eigen::Vector3d(o->up[0], o->up[1], o->up[2]);
+    LinearSpaceSettings settings = o->linearSpace.settings();
     settings.basis.rankTolerance = o->rankTolerance;
-    std::vector<FaceSpace> spaces = requestedAssignment(o->space, o->facesFile, mesh.faceCount());
+    std::vector<FaceSpace> spaces = o->linearSpace.assignment(mesh.faceCount());
     ReassignmentInfo reassignment;
     if (o->reassign) {
       ReassignmentSettings rs;
@@ -67,7 +60,7 @@ RunFunction setup(CLI::App& app) {
 
     nlohmann::json j = baseReport("subspace", backend, mesh, planarityStats(mesh), seconds);
     j["status"] = "ok";  // failures (rank, basis) end in Error(Numerical) and main's failure report
-    j["space"] = o->space;
+    j["space"] = o->linearSpace.space;
     j["dimension"] = space.dof.dimension;
     j["lower_bound"] = space.dof.lowerBound;
     j["free_vertices"] = space.dof.freeVertices;
@@ -97,7 +90,7 @@ RunFunction setup(CLI::App& app) {
                      {"boundary_vertices", topology.boundaryVertices},
                      {"boundary_loops", topology.boundaryLoopCount()},
                      {"genus", topology.genus}};
-    std::cout << o->input << ": " << o->space << " space, dimension " << space.dof.dimension << " (lower bound "
+    std::cout << o->input << ": " << o->linearSpace.space << " space, dimension " << space.dof.dimension << " (lower bound "
               << space.dof.lowerBound << "), free vertices " << space.dof.freeVertices << ", "
               << nonMaximal.size() << " non-maximal face(s), " << seconds << " s\n";
     progress(global, "basis: " + j["basis_method"].get<std::string>() + ", rank " + std::to_string(space.basisInfo.rank) +

@@ -10,7 +10,6 @@
 #include "plano/CommandOutcome.h"
 #include "plano/OutputGuard.h"
 #include "plano/Report.h"
-#include "subspace/FaceAssignmentIO.h"
 #include "subspace/SubspaceDeformation.h"
 
 namespace plano::cli {
@@ -26,9 +25,9 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   if (!warnings.empty()) std::cerr << warnings;
   if (constraints.empty()) throwBadInput(request.constraints + ": no fixed vertex and no handle");
   const LinearSpace space =
-      buildLinearSpace(mesh, requestedAssignment(request.space, request.facesFile, mesh.faceCount()));
+      buildLinearSpace(mesh, request.linearSpace.assignment(mesh.faceCount()), request.linearSpace.settings());
   warnIfFacesAreNotPlanar("deform", space);
-  progress(global, request.space + " space: dimension " + std::to_string(space.dof.dimension));
+  progress(global, request.linearSpace.space + " space: dimension " + std::to_string(space.dof.dimension));
   auto backend = makeBackend(global);
   SubspaceDeformationSettings settings;
   settings.energy = parseDeformationEnergy(request.energy);
@@ -41,7 +40,7 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   const PlanarityStats stats = planarityStats(out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json j = baseReport("deform", backend->name(), out, stats, seconds);
-  j["space"] = request.space;
+  j["space"] = request.linearSpace.space;
   j["energy"] = request.energy;
   j["dimension"] = space.dof.dimension;
   j["free_dimension"] = deformer.freeDimension();
@@ -57,7 +56,7 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
                       " iterations";
   }
   finishCommand("deform", outcome, request.keepPartial, {{request.output, &out}}, j, request.report);
-  std::cout << "deformed in the " << request.space << " space (dimension " << space.dof.dimension << ") in "
+  std::cout << "deformed in the " << request.linearSpace.space << " space (dimension " << space.dof.dimension << ") in "
             << info.iterations << " iterations, handle distance " << info.maxHandleDistance << ", max planarity "
             << stats.max << "% -> " << request.output << "\n";
   return 0;

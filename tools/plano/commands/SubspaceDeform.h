@@ -5,14 +5,14 @@
 #include <string>
 
 #include "plano/Command.h"
+#include "plano/LinearSpaceOptions.h"
 
 namespace plano::cli {
 
 struct SubspaceDeformRequest {
   std::string mesh;              ///< Input polyhedral mesh.
   std::string constraints;       ///< Constraints JSON (mesh/Constraints.h).
-  std::string space = "affine";  ///< affine | parallel | vertical | mixed
-  std::string facesFile;         ///< Per-face types for mixed.
+  LinearSpaceOptions linearSpace;  ///< --space, --faces-file, --up.
   std::string energy = "asap";   ///< asap | arap
   std::string output;            ///< Output mesh.
   std::string report;            ///< JSON report path (optional).
