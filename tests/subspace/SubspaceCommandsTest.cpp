@@ -134,6 +134,23 @@ TEST(DualCommand, WritesTheDualAndAnExploredPrimal) {
   EXPECT_LE(planarityStats(primal).max, 1e-3);
 }
 
+TEST(DualCommand, TheUpVectorChoosesTheDualsVerticalSpace) {
+  // The cube's dual, an octahedron, has more vertical meshes for up = z, an axis of its
+  // symmetry, than for a generic up vector.
+  TempDir dir;
+  writeMesh(dir / "cube.obj", generate::cube());
+  const auto dimensionFor = [&](const std::string& up) {
+    const auto result = runTool("-q dual " + quoted(dir / "cube.obj") + " -o " + quoted(dir / "dual.obj") +
+                                " --primal " + quoted(dir / "primal.obj") + " --space vertical --eigenshape 0" + up +
+                                " --report " + quoted(dir / "r.json"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    return result.exitCode == 0 ? readJson(dir / "r.json")["exploration"]["dimension"].get<int>() : -1;
+  };
+  const int alongZ = dimensionFor("");
+  EXPECT_EQ(dimensionFor(" --up 0,0,2"), alongZ);
+  EXPECT_LT(dimensionFor(" --up 0.3,0.1,1"), alongZ);
+}
+
 TEST(EmbedCommand, LiftsATutteEmbeddingOfADisk) {
   TempDir dir;
   writeMesh(dir / "grid.obj", generate::hyparGrid(6));

@@ -14,6 +14,10 @@ subspace::LinearSpaceSettings LinearSpaceOptions::settings() const {
   return settings;
 }
 
+void addUpOption(CLI::App& app, std::vector<double>& up) {
+  app.add_option("--up", up, "Up vector of the vertical faces, X,Y,Z")->delimiter(',')->expected(3)->capture_default_str();
+}
+
 void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options, const std::string& spaceHelp) {
   auto* space = app.add_option("--space", options.space, spaceHelp)
                     ->check(CLI::IsMember({"affine", "parallel", "vertical", "mixed"}));
@@ -21,10 +25,7 @@ void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options, const std
   app.add_option("--faces-file", options.facesFile,
                  "With --space mixed: per-face types, one word per face in face order (affine | parallel | "
                  "vertical, or a | p | v)");
-  app.add_option("--up", options.up, "Up vector of the vertical faces, X,Y,Z")
-      ->delimiter(',')
-      ->expected(3)
-      ->capture_default_str();
+  addUpOption(app, options.up);
 }
 
 }  // namespace plano::cli

@@ -23,6 +23,9 @@ struct LinearSpaceOptions {
   subspace::LinearSpaceSettings settings() const;
 };
 
+/// Register --up alone (`dual`, whose --space has fewer choices).
+void addUpOption(CLI::App& app, std::vector<double>& up);
+
 /// Register --space (described by `spaceHelp`, its default shown when `options.space` has
 /// one), --faces-file and --up on `app`, writing into `options`.
 void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options,

@@ -9,6 +9,7 @@
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
 #include "plano/CommandOutcome.h"
+#include "plano/LinearSpaceOptions.h"
 #include "plano/Report.h"
 #include "subspace/Eigenshapes.h"
 #include "subspace/LinearSpace.h"
@@ -22,7 +23,7 @@ using namespace plano::subspace;
 
 struct DualOptions {
   std::string input, output, report, primal;
-  std::string space = "parallel";
+  LinearSpaceOptions linearSpace = {.space = "parallel"};  ///< Of the dual; not mixed.
   Index eigenshape = 3;
   double amplitude = 0.05;
   bool keepPartial = false;
@@ -33,9 +34,10 @@ RunFunction setup(CLI::App& app) {
   app.add_option("mesh", o->input, "Polyhedral mesh (no face plane through the origin)")->required();
   app.add_option("-o,--output", o->output, "Output dual mesh")->required();
   app.add_option("--primal", o->primal, "Explore the dual: write the primal of the edited dual here");
-  app.add_option("--space", o->space, "Linear space of the dual to explore: affine | parallel | vertical")
+  app.add_option("--space", o->linearSpace.space, "Linear space of the dual to explore: affine | parallel | vertical")
       ->check(CLI::IsMember({"affine", "parallel", "vertical"}))
       ->capture_default_str();
+  addUpOption(app, o->linearSpace.up);
   app.add_option("--eigenshape", o->eigenshape, "Which eigenshape of the dual's space to add (0 = lowest)")
       ->capture_default_str();
   app.add_option("--amplitude", o->amplitude, "Peak displacement of the dual, relative to its bounding-box diagonal")
@@ -59,25 +61,26 @@ RunFunction setup(CLI::App& app) {
     nlohmann::json exploration;
     PolygonMesh primal = mesh;
     if (!o->primal.empty()) {
-      const LinearSpace space = buildLinearSpace(dual, uniformAssignment(parseSpaceKind(o->space), dual.faceCount()));
+      const LinearSpace space =
+          buildLinearSpace(dual, o->linearSpace.assignment(dual.faceCount()), o->linearSpace.settings());
       EigenshapeSettings es;
       es.count = o->eigenshape + 1;
       const Eigenshapes shapes = computeEigenshapes(*backend, space.N, uniformLaplacian(dual.faces, dual.vertexCount()), es);
       if (o->eigenshape >= shapes.count()) {
-        throwUsage("--eigenshape " + std::to_string(o->eigenshape) + " but the dual's " + o->space + " space has dimension " +
-                   std::to_string(space.N.dimension()));
+        throwUsage("--eigenshape " + std::to_string(o->eigenshape) + " but the dual's " + o->linearSpace.space +
+                   " space has dimension " + std::to_string(space.N.dimension()));
       }
       const Positions edited = bandPass(space.N, shapes, space.N.project(dual.vertices), o->eigenshape,
                                         o->eigenshape + 1, o->amplitude);
       primal.vertices = primalFromDual(mesh.faces, edited, mesh.vertices);
       stats = planarityStats(primal);
-      exploration = {{"space", o->space},
+      exploration = {{"space", o->linearSpace.space},
                      {"dimension", space.dof.dimension},
                      {"eigenshape", o->eigenshape},
                      {"frequency", shapes.frequencies[o->eigenshape]},
                      {"primal", o->primal},
                      {"primal_max_planarity", stats.max}};
-      std::cout << "explored the dual's " << o->space << " space (dimension " << space.dof.dimension
+      std::cout << "explored the dual's " << o->linearSpace.space << " space (dimension " << space.dof.dimension
                 << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
