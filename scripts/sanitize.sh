@@ -12,7 +12,7 @@ BUILD_DIR=${PLANO_SANITIZE_BUILD_DIR:-build-sanitize}
 cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="${PLANO_SANITIZE_CXX:-clang++}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DPLANO_SANITIZE=ON -DPLANO_BUILD_BENCHMARKS=OFF \
   -DPLANO_UNITY_BUILD="${PLANO_UNITY_BUILD:-ON}" >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)" --target plano plano_tests
+cmake --build "$BUILD_DIR" -j"$(nproc)" --target plano plano_tests plano_quickstart
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
 # LeakSanitizer is off: the Vulkan loader and lavapipe keep process-lifetime allocations.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0:abort_on_error=1}

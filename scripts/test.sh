@@ -29,6 +29,19 @@ if [[ "$stages" == *" release "* ]]; then
   cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPLANO_UNITY_BUILD="${PLANO_UNITY_BUILD:-ON}" >/dev/null
   timed "release build" cmake --build "$BUILD_DIR" -j"$(nproc)"
   timed "release tests" ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)"
+  # The installed package as another project sees it: examples/ built on its own against
+  # `cmake --install` (find_package(Plano), Plano::plano), and its program run.
+  installed_package_check() {
+    local prefix consumer
+    prefix=$(realpath -m "$BUILD_DIR/installed-package")
+    consumer=$(realpath -m "$BUILD_DIR/installed-package-examples")
+    rm -rf "$prefix" "$consumer"
+    cmake --install "$BUILD_DIR" --prefix "$prefix" >/dev/null
+    cmake -S examples -B "$consumer" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+    cmake --build "$consumer" -j"$(nproc)" >/dev/null
+    "$consumer/plano_quickstart" "$consumer/quickstart.obj"
+  }
+  timed "installed package" installed_package_check
 fi
 if [[ "$stages" == *" sanitize "* ]]; then
   echo "== stage 2/3: AddressSanitizer + UndefinedBehaviorSanitizer build and tests" >&2
