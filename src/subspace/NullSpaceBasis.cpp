@@ -5,6 +5,7 @@
 #include <Eigen/SPQRSupport>
 
 #include "core/Error.h"
+#include "core/Memory.h"
 
 namespace plano::subspace {
 namespace {
@@ -30,7 +31,8 @@ Eigen::MatrixXd denseNullSpace(const compute::SparseMatrix& B, double tolerance,
   return svd.matrixV().rightCols(n - r);
 }
 
-Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance, Index& rank) {
+Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance, std::uint64_t memoryLimit,
+                                Index& rank) {
   using SpqrMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, SuiteSparse_long>;
   const Eigen::Index n = B.cols();
   if (B.rows() == 0) {
@@ -47,6 +49,12 @@ Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance
   qr.compute(At);
   if (qr.info() != Eigen::Success) throwNumerical("sparse QR of the constraint matrix failed");
   rank = static_cast<Index>(qr.rank());
+  // The selector and N, both n x (n - rank), live at once.
+  const double basisBytes = static_cast<double>(n) * static_cast<double>(n - rank) * sizeof(double);
+  requireMemory(2.0 * basisBytes,
+                "the null-space basis (" + std::to_string(n) + " unknowns x " + std::to_string(n - rank) +
+                    " dimensions, formed from a selector of its size)",
+                memoryLimit);
   Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(n, n - rank);
   selector.bottomRows(n - rank).setIdentity();
   Eigen::MatrixXd N;
@@ -63,7 +71,7 @@ SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettin
   Index rank = 0;
   const double tolerance = std::max(settings.rankTolerance, settings.noiseFactor * B.maxNonPlanarity);
   Eigen::MatrixXd N = method == BasisMethod::DenseSvd ? denseNullSpace(B.matrix, tolerance, rank)
-                                                      : sparseNullSpace(B.matrix, tolerance, rank);
+                                                      : sparseNullSpace(B.matrix, tolerance, settings.memoryLimitBytes, rank);
   if (!N.allFinite()) throwNumerical("null-space basis of the constraint matrix is not finite");
   SubspaceBasis basis(std::move(N), B.separable);
   if (info) {

@@ -1,6 +1,8 @@
 #pragma once
 // An orthonormal basis of null(B) (linear-spaces paper, §4 "Implementation details": a
 // sparse QR decomposition gives N; then every member of the space is N W).
+#include <cstdint>
+
 #include "subspace/ConstraintMatrix.h"
 #include "subspace/SubspaceBasis.h"
 
@@ -24,6 +26,12 @@ struct BasisSettings {
   double noiseFactor = 10.0;
   /// Unknowns (#V when separable, else 3 #V) up to which Auto uses the dense SVD.
   Index denseLimit = 400;
+  /// Memory the dense basis may take while it is formed (bytes; 0: what the system has
+  /// available). The basis is #unknowns x dim null(B) doubles, formed from a selector of
+  /// the same size: on a large mesh it outgrows the machine (a 1M-quad grid's affine space,
+  /// ~2 000 scalar columns, would need ~32 GiB), and is refused with Error(Numerical) once
+  /// the sparse QR has given its dimension, before anything that size is allocated.
+  std::uint64_t memoryLimitBytes = 0;
 };
 
 struct BasisInfo {

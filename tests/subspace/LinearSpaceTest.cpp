@@ -186,6 +186,32 @@ TEST(LinearSpace, SparseQrAndDenseSvdAgreeOnTheDimension) {
   }
 }
 
+TEST(LinearSpace, ABasisLargerThanItsMemoryLimitIsRefusedNamingItsSize) {
+  // The 6x5 grid's parallel space: 126 unknowns and its dimension, in a basis and a
+  // selector of 8 bytes an entry. Refused under a limit below that, before it is formed;
+  // built under one above.
+  const PolygonMesh mesh = generate::translationalSurface(6, 5);
+  const auto spaces = uniformAssignment(SpaceKind::Parallel, mesh.faceCount());
+  LinearSpaceSettings settings;
+  settings.basis.method = BasisMethod::SparseQr;
+  const Index dimension = buildLinearSpace(mesh, spaces, settings).N.dimension();
+  const auto needed = static_cast<std::uint64_t>(2 * 126 * dimension * sizeof(double));
+  settings.basis.memoryLimitBytes = needed - 1;
+  try {
+    buildLinearSpace(mesh, spaces, settings);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    const std::string message = e.what();
+    EXPECT_NE(message.find("out of memory: the null-space basis (126 unknowns x " + std::to_string(dimension) +
+                           " dimensions"),
+              std::string::npos)
+        << message;
+  }
+  settings.basis.memoryLimitBytes = needed;
+  EXPECT_EQ(buildLinearSpace(mesh, spaces, settings).N.dimension(), dimension);
+}
+
 TEST(LinearSpace, HorizontalFacesOfAVerticalSpaceFallBackToParallel) {
   const PolygonMesh cube = generate::cube();
   const ConstraintMatrix B = buildConstraintMatrix(cube, uniformAssignment(SpaceKind::Vertical, 6));
