@@ -62,7 +62,8 @@ RunFunction setup(CLI::App& app) {
 }
 
 const CommandRegistration registration{
-    {"interpolate", "Interpolate or extrapolate between two polyhedral meshes (projective maps, paper 7.1)", setup, 46}};
+    {"interpolate",
+     "Interpolate or extrapolate between two polyhedral meshes (projective-maps paper, §7.1)", setup, 46}};
 
 }  // namespace
 }  // namespace plano::cli

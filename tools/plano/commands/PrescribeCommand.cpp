@@ -139,7 +139,8 @@ RunFunction setup(CLI::App& app) {
 }
 
 const CommandRegistration registration{
-    {"prescribe", "Prescribe rotations, perspective warps or scalings to faces (projective maps, paper 7)", setup, 45}};
+    {"prescribe",
+     "Prescribe rotations, perspective warps or scalings to faces (projective-maps paper, §7)", setup, 45}};
 
 }  // namespace
 }  // namespace plano::cli
