@@ -1,11 +1,13 @@
 #include "projective/PqSubdivision.h"
 
 #include <algorithm>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "core/Memory.h"
 #include "core/Timing.h"
 #include "projective/GlobalStep.h"
 #include "projective/LocalStep.h"
@@ -32,6 +34,29 @@ void checkSettings(const PqSubdivisionSettings& settings) {
   if (!(settings.changeTolerance > 0.0)) throwUsage("subdivision: the change tolerance must be positive");
   if (settings.maxIterationsPerLevel < 1) throwUsage("subdivision: at least one iteration per level is needed");
   if (settings.intermediateAttempts < 0) throwUsage("subdivision: the intermediate attempts must be >= 0");
+}
+
+/// What a subdivision holds per face of its finest level, measured on the cube (2026-12-05,
+/// `plano subdivide`'s peak memory): the linear scheme 247 B (11 levels, 25M faces, 6.07 GB:
+/// the hierarchy and positions 206 B, the output file's text 41 B), taken as 250; a
+/// planarized finest level 4.1 KB (the 98k-face level, which needed no ADMM iteration) to
+/// 19 KB (6 levels, 24k faces), of which half the smaller is taken.
+constexpr double kLinearBytesPerFinestFace = 250.0;
+constexpr double kPlanarizedBytesPerFinestFace = 2048.0;
+
+/// The hierarchy is built for every level at once: refuse levels that cannot fit before
+/// any is built. 12 linear levels of the cube (100M faces, ~25 GB) were killed by the
+/// kernel after 2 minutes on a 23 GiB machine: Linux grants the allocations and kills the
+/// process once it fills them.
+void requireMemoryForLevels(const FaceList& base, const PqSubdivisionSettings& settings) {
+  if (settings.levels == 0) return;
+  double finestFaces = static_cast<double>(base.cornerCount());  // level 1: a quad per corner
+  for (int level = 2; level <= settings.levels; ++level) finestFaces *= 4.0;
+  std::ostringstream what;
+  what << "subdividing " << base.size() << " faces " << settings.levels << " times (" << std::fixed << std::setprecision(0)
+       << finestFaces << " faces at the finest level" << (settings.planarize ? ", planarized" : "") << ")";
+  requireMemory(finestFaces * (settings.planarize ? kPlanarizedBytesPerFinestFace : kLinearBytesPerFinestFace),
+                what.str(), settings.memoryLimitBytes);
 }
 
 /// Every face of a level is a projective image of its base face, the trivial refinement of
@@ -122,6 +147,7 @@ const char* toString(PqSubdivisionStatus status) {
 PqSubdivisionResult subdividePlanarQuads(compute::Backend& backend, const PolygonMesh& base,
                                          const PqSubdivisionSettings& settings, const PqIterationCallback& callback) {
   checkSettings(settings);
+  requireMemoryForLevels(base.faces, settings);
   const auto start = SteadyClock::now();
   PqSubdivisionResult result{SubdivisionHierarchy(base.faces, base.vertexCount(), settings.levels), {base.vertices}, {}};
   PqSubdivisionInfo& info = result.info;

@@ -10,6 +10,7 @@
 // until the max planarity is under the bound and the max vertex change between two
 // iterations (the first compared with the linear targets) is under `changeTolerance`
 // times the bounding-box diagonal. The result of a level is the coarse mesh of the next.
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct PqSubdivisionSettings {
   /// end above the bound either way; with the 5 % condition 18 % more). 0: never.
   int intermediateAttempts = 3;
   GlobalStepSettings globalStep;
+  /// Memory the levels may take (bytes; 0: what the system has available). Levels whose
+  /// finest faces would need more, by a measured lower bound per face, are refused with
+  /// Error(Numerical) before any is built.
+  std::uint64_t memoryLimitBytes = 0;
 };
 
 enum class PqSubdivisionStatus {

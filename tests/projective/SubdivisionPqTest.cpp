@@ -234,6 +234,37 @@ TEST_F(SubdivisionPq, LinearOnlySettingReturnsTheLinearScheme) {
   EXPECT_NEAR(result.info.levels[0].planarity.max, 4.43, 0.006);
 }
 
+TEST_F(SubdivisionPq, LevelsThatCannotFitTheMemoryLimitAreRefusedBeforeAnyIsBuilt) {
+  // Five linear levels of the cube: 6 144 faces, at least 250 B each (1.54 MB); planarized,
+  // two levels: 96 faces, at least 2 KiB each (197 kB).
+  const PolygonMesh cube = generate::cube(1.0);
+  const auto refusal = [&](const PqSubdivisionSettings& settings) -> std::string {
+    try {
+      subdividePlanarQuads(backend, cube, settings);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+      return e.what();
+    }
+    return "";
+  };
+  PqSubdivisionSettings linear;
+  linear.levels = 5;
+  linear.planarize = false;
+  linear.memoryLimitBytes = 1'500'000;
+  EXPECT_NE(refusal(linear).find("out of memory: subdividing 6 faces 5 times (6144 faces at the finest level)"),
+            std::string::npos)
+      << refusal(linear);
+  linear.memoryLimitBytes = 2'000'000;
+  EXPECT_EQ(refusal(linear), "");
+  PqSubdivisionSettings planarized;
+  planarized.levels = 2;
+  planarized.memoryLimitBytes = 150'000;
+  EXPECT_NE(refusal(planarized).find("(96 faces at the finest level, planarized)"), std::string::npos)
+      << refusal(planarized);
+  planarized.memoryLimitBytes = 250'000;
+  EXPECT_EQ(refusal(planarized), "");
+}
+
 TEST_F(SubdivisionPq, AnInputTooNonPlanarForTheBoundIsRejectedNamingItsWorstFace) {
   // Every face of a level is a projective image of its base face: from faces 2.6 % non-planar
   // after the trivial refinement no iteration reached 0.1 % (20 iterations at 2.65 %).
