@@ -2,7 +2,6 @@
 
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 
 #include "core/Error.h"
 
@@ -20,7 +19,8 @@ std::optional<std::uint64_t> availableMemoryBytes() {
 }
 
 void requireMemory(double bytes, const std::string& what, std::uint64_t limit) {
-  const std::optional<std::uint64_t> available = limit > 0 ? std::optional<std::uint64_t>(limit) : availableMemoryBytes();
+  const std::optional<std::uint64_t> available =
+      limit > 0 ? std::optional<std::uint64_t>(limit) : availableMemoryBytes();
   if (!available || bytes <= static_cast<double>(*available)) return;
   constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
   char sizes[96];

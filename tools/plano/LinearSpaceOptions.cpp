@@ -15,7 +15,10 @@ subspace::LinearSpaceSettings LinearSpaceOptions::settings() const {
 }
 
 void addUpOption(CLI::App& app, std::vector<double>& up) {
-  app.add_option("--up", up, "Up vector of the vertical faces, X,Y,Z")->delimiter(',')->expected(3)->capture_default_str();
+  app.add_option("--up", up, "Up vector of the vertical faces, X,Y,Z")
+      ->delimiter(',')
+      ->expected(3)
+      ->capture_default_str();
 }
 
 void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options, const std::string& spaceHelp) {
