@@ -70,8 +70,9 @@ SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettin
   if (method == BasisMethod::Auto) method = unknowns <= settings.denseLimit ? BasisMethod::DenseSvd : BasisMethod::SparseQr;
   Index rank = 0;
   const double tolerance = std::max(settings.rankTolerance, settings.noiseFactor * B.maxNonPlanarity);
-  Eigen::MatrixXd N = method == BasisMethod::DenseSvd ? denseNullSpace(B.matrix, tolerance, rank)
-                                                      : sparseNullSpace(B.matrix, tolerance, settings.memoryLimitBytes, rank);
+  Eigen::MatrixXd N = method == BasisMethod::DenseSvd
+                          ? denseNullSpace(B.matrix, tolerance, rank)
+                          : sparseNullSpace(B.matrix, tolerance, settings.memoryLimitBytes, rank);
   if (!N.allFinite()) throwNumerical("null-space basis of the constraint matrix is not finite");
   SubspaceBasis basis(std::move(N), B.separable);
   if (info) {
