@@ -1,5 +1,8 @@
 #include "plano/LinearSpaceOptions.h"
 
+#include <chrono>
+#include <cstdio>
+
 #include "subspace/FaceAssignmentIO.h"
 
 namespace plano::cli {
@@ -29,6 +32,24 @@ void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options, const std
                  "With --space mixed: per-face types, one word per face in face order (affine | parallel | "
                  "vertical, or a | p | v)");
   addUpOption(app, options.up);
+}
+
+subspace::LinearSpace buildSpaceWithProgress(const GlobalOptions& global, const std::string& command,
+                                             const PolygonMesh& mesh, const std::string& spaceName,
+                                             std::span<const subspace::FaceSpace> spaces,
+                                             const subspace::LinearSpaceSettings& settings) {
+  progress(global, command + ": building the " + spaceName + " space of " + std::to_string(mesh.faceCount()) +
+                       " faces (constraint matrix, null-space basis) ...");
+  const auto start = std::chrono::steady_clock::now();
+  subspace::LinearSpace space = subspace::buildLinearSpace(mesh, spaces, settings);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  char time[32];
+  std::snprintf(time, sizeof time, "%.3g s", seconds);
+  progress(global, command + ": " + spaceName + " space: dimension " + std::to_string(space.dof.dimension) + " (" +
+                       (space.basisInfo.method == subspace::BasisMethod::DenseSvd ? "dense SVD" : "sparse QR") +
+                       " of " + std::to_string(space.basisInfo.unknowns) + " unknowns, " + time + ")");
+  warnIfFacesAreNotPlanar(command, space);
+  return space;
 }
 
 }  // namespace plano::cli

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "plano/Command.h"
 #include "subspace/FaceSpace.h"
 #include "subspace/LinearSpace.h"
 
@@ -30,5 +31,14 @@ void addUpOption(CLI::App& app, std::vector<double>& up);
 /// one), --faces-file and --up on `app`, writing into `options`.
 void addLinearSpaceOptions(CLI::App& app, LinearSpaceOptions& options,
                            const std::string& spaceHelp = "affine | parallel | vertical | mixed");
+
+/// Build the linear space `spaces` (the per-face types of the space called `spaceName`) of
+/// `mesh` for `command`: a progress line before the null-space basis, which takes a minute
+/// on a 100k-face mesh, and one with its dimension and time after (unless --quiet); the
+/// warning of warnIfFacesAreNotPlanar.
+subspace::LinearSpace buildSpaceWithProgress(const GlobalOptions& global, const std::string& command,
+                                             const PolygonMesh& mesh, const std::string& spaceName,
+                                             std::span<const subspace::FaceSpace> spaces,
+                                             const subspace::LinearSpaceSettings& settings);
 
 }  // namespace plano::cli

@@ -62,7 +62,8 @@ RunFunction setup(CLI::App& app) {
     PolygonMesh primal = mesh;
     if (!o->primal.empty()) {
       const LinearSpace space =
-          buildLinearSpace(dual, o->linearSpace.assignment(dual.faceCount()), o->linearSpace.settings());
+          buildSpaceWithProgress(global, "dual", dual, "dual's " + o->linearSpace.space,
+                                 o->linearSpace.assignment(dual.faceCount()), o->linearSpace.settings());
       EigenshapeSettings es;
       es.count = o->eigenshape + 1;
       const Eigenshapes shapes = computeEigenshapes(*backend, space.N, uniformLaplacian(dual.faces, dual.vertexCount()), es);

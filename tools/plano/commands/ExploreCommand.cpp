@@ -57,10 +57,8 @@ RunFunction setup(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     LinearSpaceSettings settings = o->linearSpace.settings();
-    const LinearSpace space =
-        buildLinearSpace(mesh, o->linearSpace.assignment(mesh.faceCount()), settings);
-    warnIfFacesAreNotPlanar("explore", space);
-    progress(global, o->linearSpace.space + " space: dimension " + std::to_string(space.dof.dimension));
+    const LinearSpace space = buildSpaceWithProgress(global, "explore", mesh, o->linearSpace.space,
+                                                     o->linearSpace.assignment(mesh.faceCount()), settings);
     EigenshapeSettings es;
     es.count = o->eigenshapes;
     EigenshapeInfo info;

@@ -86,8 +86,7 @@ RunFunction setup(CLI::App& app) {
       std::cout << "sparse shape of vertex " << o->vertex << ": " << extra["status"].get<std::string>() << ", "
                 << info.supportVertices << " vertices move, ||BX||/||X|| = " << info.residual << "\n";
     } else {
-      const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
-      warnIfFacesAreNotPlanar("shapes", space);
+      const LinearSpace space = buildSpaceWithProgress(global, "shapes", mesh, o->linearSpace.space, spaces, settings);
       FundamentalShapeSettings fs;
       fs.smoothness = o->smoothness;
       shape = fundamentalShape(*backend, space.N, uniformLaplacian(mesh.faces, mesh.vertexCount()), o->vertex, direction, fs);

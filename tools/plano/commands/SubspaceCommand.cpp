@@ -52,8 +52,7 @@ RunFunction setup(CLI::App& app) {
       rs.space = settings;
       spaces = reassignNonMaximalFaces(mesh, spaces, rs, &reassignment);
     }
-    const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
-    warnIfFacesAreNotPlanar("subspace", space);
+    const LinearSpace space = buildSpaceWithProgress(global, "subspace", mesh, o->linearSpace.space, spaces, settings);
     const auto nonMaximal = findNonMaximalFaces(space, settings.constraints);
     const SubspaceTopology topology = computeTopology(mesh.faces, mesh.vertexCount());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -25,9 +25,8 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   if (!warnings.empty()) std::cerr << warnings;
   if (constraints.empty()) throwBadInput(request.constraints + ": no fixed vertex and no handle");
   const LinearSpace space =
-      buildLinearSpace(mesh, request.linearSpace.assignment(mesh.faceCount()), request.linearSpace.settings());
-  warnIfFacesAreNotPlanar("deform", space);
-  progress(global, request.linearSpace.space + " space: dimension " + std::to_string(space.dof.dimension));
+      buildSpaceWithProgress(global, "deform", mesh, request.linearSpace.space,
+                             request.linearSpace.assignment(mesh.faceCount()), request.linearSpace.settings());
   auto backend = makeBackend(global);
   SubspaceDeformationSettings settings;
   settings.energy = parseDeformationEnergy(request.energy);
