@@ -1,6 +1,7 @@
 // plano: command-line tool for polyhedral meshes. Each sub-command lives in
 // tools/plano/commands/ and registers itself (Command.h).
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -73,6 +74,25 @@ std::function<void(const compute::AdmmCheck&)> admmHeartbeat(const GlobalOptions
   };
 }
 
+namespace {
+
+/// Every floating-point option (CLI11's FLOAT values, lists included) must be finite: a NaN
+/// passes every "> 0" check, and a NaN or Inf weight, tolerance, amplitude or coordinate
+/// would otherwise run (or fail as a numerical error) instead of being a usage error.
+void requireFiniteFloatOptions(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value)) return "must be finite, got " + text;
+        return {};
+      },
+      "");
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+  }
+}
+
+}  // namespace
 }  // namespace plano::cli
 
 int main(int argc, char** argv) {
@@ -97,6 +117,7 @@ int main(int argc, char** argv) {
     // Global options are accepted after the sub-command name too: `plano info --backend cpu m.obj`.
     sub->fallthrough();
     commands.emplace_back(sub, info.setup(*sub));
+    requireFiniteFloatOptions(*sub);
   }
 
   try {

@@ -44,7 +44,9 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--direction", o->direction, "Direction X,Y,Z (default: the vertex normal)")->delimiter(',')->expected(3);
   app.add_option("--amplitude", o->amplitude, "Peak displacement relative to the bounding-box diagonal")->capture_default_str();
   app.add_option("--smoothness", o->smoothness, "lambda of the fundamental shape")->capture_default_str();
-  app.add_option("--max-support", o->maxSupport, "Sparse shape: most vertices that may move")->capture_default_str();
+  app.add_option("--max-support", o->maxSupport, "Sparse shape: most vertices that may move (the seed included)")
+      ->check(CLI::Range(Index{1}, Index{1'000'000'000}))
+      ->capture_default_str();
   app.add_option("-o,--output", o->output, "Output mesh")->required();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
