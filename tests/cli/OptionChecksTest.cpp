@@ -17,7 +17,8 @@ TEST(CommandOptions, NonFiniteNumbersAreUsageErrorsOfEveryCommandAndWriteNothing
   const test::TempDir dir;
   writeMesh(dir / "grid.obj", generate::translationalSurface(4, 4));
   {
-    std::ofstream(dir / "c.json") << R"({"fixed": [0, 1, 2, 3, 4], "handles": [{"vertex": 24, "position": [4, 4, 1]}]})";
+    std::ofstream(dir / "c.json") << R"({"fixed": [0, 1, 2, 3, 4],
+                                        "handles": [{"vertex": 24, "position": [4, 4, 1]}]})";
   }
   const std::string grid = (dir / "grid.obj").string(), out = (dir / "out.obj").string();
   const std::string constraints = (dir / "c.json").string();
@@ -35,6 +36,26 @@ TEST(CommandOptions, NonFiniteNumbersAreUsageErrorsOfEveryCommandAndWriteNothing
   // Finite values of the same options run.
   EXPECT_EQ(test::runTool("-q explore " + grid + " -o " + out + " --amplitude 0.02").exitCode, 0);
   EXPECT_TRUE(std::filesystem::exists(out));
+}
+
+TEST(CommandOptions, WrittenFilesOverInputsOrIntoMissingFoldersAreRefusedBeforeTheRun) {
+  // `subdivide -o` named its input: until 2026-12-05 it was overwritten without --in-place.
+  const test::TempDir dir;
+  writeMesh(dir / "grid.obj", generate::translationalSurface(4, 4));
+  const std::string grid = (dir / "grid.obj").string(), out = (dir / "out.obj").string();
+  const std::string missing = (dir / "missing").string();
+  const auto before = std::filesystem::last_write_time(grid);
+  for (const std::string& command :
+       {"subdivide " + grid + " -o " + grid, "explore " + grid + " -o " + out + " --report " + grid,
+        "subdivide " + grid + " -o " + missing + "/out.obj",
+        "subdivide " + grid + " -o " + out + " --report " + missing + "/r.json",
+        "subdivide " + grid + " -o " + out + " --report " + out}) {
+    const test::ToolResult result = test::runTool("-q " + command);
+    EXPECT_EQ(result.exitCode, 2) << command << "\n" << result.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.obj")) << command;
+  }
+  EXPECT_EQ(std::filesystem::last_write_time(grid), before);
+  EXPECT_EQ(test::runTool("-q subdivide " + grid + " --in-place --linear").exitCode, 0);
 }
 
 }  // namespace

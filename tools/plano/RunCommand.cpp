@@ -31,6 +31,7 @@ int runCommand(const CommandRun& command, GlobalOptions options, std::ostream& e
   const std::size_t reportsBefore = reportsWritten();
   try {
     try {
+      checkCommandPaths(command.paths);
       return runOnce(command, options);
     } catch (const Error& e) {
       // With auto, a device error can only come from a Vulkan backend (the CPU one has no device).

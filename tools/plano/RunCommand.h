@@ -5,6 +5,7 @@
 #include <string>
 
 #include "plano/Command.h"
+#include "plano/OutputGuard.h"
 
 namespace plano::cli {
 
@@ -12,6 +13,8 @@ struct CommandRun {
   std::string name;        ///< Sub-command name, for the failure report.
   RunFunction run;
   std::string reportPath;  ///< --report of the command; empty when not given.
+  /// Checked before the command runs (checkCommandPaths); a usage error when they clash.
+  CommandPaths paths;
 };
 
 /// Run the command. With --backend auto, a device failure (the Vulkan device broke

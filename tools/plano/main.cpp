@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "plano/Command.h"
+#include "plano/OutputGuard.h"
 #include "plano/RunCommand.h"
 
 namespace plano::cli {
@@ -92,6 +93,25 @@ void requireFiniteFloatOptions(CLI::App& app) {
   }
 }
 
+/// The files a parsed command reads and writes, by the names every command gives its
+/// options (positional "mesh", "topology", "a", "b"; --base, --constraints, --fixed,
+/// --faces-file read; --output, --primal, --report written, in that order).
+CommandPaths commandPaths(const CLI::App& command) {
+  const auto given = [&](const std::string& name) -> std::string {
+    const CLI::Option* option = command.get_option_no_throw(name);
+    return option != nullptr && option->count() > 0 ? option->as<std::string>() : std::string();
+  };
+  CommandPaths paths;
+  for (const char* name : {"mesh", "topology", "a", "b", "--base", "--constraints", "--fixed", "--faces-file"}) {
+    if (const std::string path = given(name); !path.empty()) paths.inputs.push_back(path);
+  }
+  for (const char* name : {"--output", "--primal", "--report"}) paths.outputs.push_back({name, given(name)});
+  const CLI::Option* inPlace = command.get_option_no_throw("--in-place");
+  paths.inPlaceOption = inPlace != nullptr;
+  paths.inPlace = inPlace != nullptr && inPlace->count() > 0;
+  return paths;
+}
+
 }  // namespace
 }  // namespace plano::cli
 
@@ -130,8 +150,8 @@ int main(int argc, char** argv) {
     for (auto& [sub, run] : commands) {
       if (!sub->parsed()) continue;
       CommandRun command{sub->get_name(), run, {}};
-      const CLI::Option* report = sub->get_option_no_throw("--report");
-      if (report != nullptr && report->count() > 0) command.reportPath = report->as<std::string>();
+      command.paths = commandPaths(*sub);
+      command.reportPath = command.paths.outputs.back().path;  // --report
       return runCommand(command, options, std::cerr);
     }
     return plano::exitCode(plano::ErrorKind::Usage);

@@ -270,12 +270,6 @@ DeformOutcome runMethod(const DeformOptions& options, const GlobalOptions& globa
   return runSingleLevel(options, global, backend, mesh, constraints);
 }
 
-bool samePath(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (std::filesystem::exists(a) && std::filesystem::exists(b)) return std::filesystem::equivalent(a, b, ec);
-  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
-}
-
 RunFunction setup(CLI::App& app) {
   auto options = std::make_shared<DeformOptions>();
   app.add_option("mesh", options->input, "Polyhedral mesh to deform (.obj, .off, .ply)")->required();
@@ -336,16 +330,12 @@ RunFunction setup(CLI::App& app) {
       request.energy = options->energy == "similar" ? "asap" : "arap";
       request.output = options->output;
       request.report = options->report;
-      request.inPlace = options->inPlace;
       request.keepPartial = options->keepPartial;
       if (options->maxIterationsOption->count() > 0) request.maxIterations = options->maxIterations;
       if (options->toleranceOption->count() > 0) request.tolerance = options->tolerance;
       return runSubspaceDeform(request, global);
     }
     const auto start = std::chrono::steady_clock::now();
-    if (!options->inPlace && samePath(options->input, options->output)) {
-      throwUsage("output " + options->output + " is the input mesh; pass --in-place to overwrite it");
-    }
     const PolygonMesh mesh = readMesh(options->input);
     std::string warnings;
     const PositionalConstraints constraints = readConstraints(options->constraints, mesh.vertexCount(), &warnings);

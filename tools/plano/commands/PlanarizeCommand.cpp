@@ -32,12 +32,6 @@ struct PlanarizeOptions {
   bool inPlace = false;
 };
 
-bool sameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec)) return true;
-  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
-}
-
 nlohmann::json reportJson(const PlanarizeOptions& options, const planarize::Settings& settings,
                           const planarize::Info& info, const PolygonMesh& result, const std::string& backend,
                           double seconds) {
@@ -82,9 +76,6 @@ RunFunction setup(CLI::App& app) {
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     if (options->output.empty()) throwUsage("planarize: no output file (use -o OUT)");
-    if (!options->inPlace && sameFile(options->input, options->output)) {
-      throwUsage("planarize: output '" + options->output + "' is the input file (pass --in-place to overwrite it)");
-    }
     PolygonMesh mesh = readMesh(options->input);
     planarize::Settings settings;
     settings.method = planarize::parseMethod(options->method);

@@ -70,11 +70,6 @@ RunFunction setup(CLI::App& app) {
   addKeepPartialFlag(app, options->keepPartial);
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
-    std::error_code ec;
-    if (!options->inPlace && std::filesystem::exists(options->output) &&
-        std::filesystem::equivalent(options->input, options->output, ec)) {
-      throwUsage("output " + options->output + " is the input mesh; pass --in-place to overwrite it");
-    }
     const PolygonMesh mesh = readMesh(options->input);
     PositionalConstraints constraints;
     if (!options->constraints.empty()) {

@@ -8,7 +8,6 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/CommandOutcome.h"
-#include "plano/OutputGuard.h"
 #include "plano/Report.h"
 #include "subspace/SubspaceDeformation.h"
 
@@ -18,7 +17,6 @@ int runSubspaceDeform(const SubspaceDeformRequest& request, const GlobalOptions&
   using namespace plano::subspace;
   const auto start = std::chrono::steady_clock::now();
   if (request.maxIterations < 1) throwUsage("max iterations must be at least 1");
-  checkOutputPath(request.mesh, request.output, request.inPlace);
   const PolygonMesh mesh = readMesh(request.mesh);
   std::string warnings;
   const PositionalConstraints constraints = readConstraints(request.constraints, mesh.vertexCount(), &warnings);

@@ -16,7 +16,6 @@ struct SubspaceDeformRequest {
   std::string energy = "asap";   ///< asap | arap
   std::string output;            ///< Output mesh.
   std::string report;            ///< JSON report path (optional).
-  bool inPlace = false;          ///< Allow the output to overwrite the input mesh.
   bool keepPartial = false;      ///< Write the last iterate even when the iteration cap was hit.
   int maxIterations = 100;
   double tolerance = 1e-8;       ///< Relative energy decrease that stops the iteration.
