@@ -54,7 +54,8 @@ TEST_F(DeformCommand, BadConstraintFilesExitWithThree) {
   write("range.json", R"({"fixed": [49]})");
   write("nan.json", R"({"handles": [{"vertex": 3, "position": [0, "x", 1]}]})");
   write("broken.json", R"({"fixed": [1, )");
-  for (const char* name : {"twice.json", "range.json", "nan.json", "broken.json"}) {
+  write("empty.json", R"({})");  // no constraint at all: most likely the wrong file (as with --space)
+  for (const char* name : {"twice.json", "range.json", "nan.json", "broken.json", "empty.json"}) {
     const auto r = test::runTool("deform " + path("grid.obj") + " --constraints " + path(name) + " -o " + path("o.obj"));
     EXPECT_EQ(r.exitCode, 3) << name << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir / "o.obj")) << name;

@@ -340,7 +340,9 @@ RunFunction setup(CLI::App& app) {
     std::string warnings;
     const PositionalConstraints constraints = readConstraints(options->constraints, mesh.vertexCount(), &warnings);
     if (!warnings.empty()) std::cerr << warnings;
-    if (constraints.handles.empty()) progress(global, "warning: no handles: the mesh will not move");
+    // As `deform --space`: a file without any constraint is most likely the wrong file.
+    if (constraints.empty()) throwBadInput(options->constraints + ": no fixed vertex and no handle");
+    if (constraints.handles.empty()) std::cerr << "warning: no handles: the mesh will not move" << std::endl;
     auto backend = makeBackend(global);
 
     const DeformOutcome outcome = runMethod(*options, global, *backend, mesh, constraints);
