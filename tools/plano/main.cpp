@@ -149,9 +149,8 @@ int main(int argc, char** argv) {
   try {
     for (auto& [sub, run] : commands) {
       if (!sub->parsed()) continue;
-      CommandRun command{sub->get_name(), run, {}};
-      command.paths = commandPaths(*sub);
-      command.reportPath = command.paths.outputs.back().path;  // --report
+      const CommandPaths paths = commandPaths(*sub);
+      const CommandRun command{sub->get_name(), run, paths.outputs.back().path /* --report */, paths};
       return runCommand(command, options, std::cerr);
     }
     return plano::exitCode(plano::ErrorKind::Usage);
