@@ -28,7 +28,7 @@ struct FakeCommand {
               if (options.backend == failingBackend) failure();
               return 0;
             },
-            reportPath, {}};
+            {{}, {{"--report", reportPath}}}};
   }
 };
 

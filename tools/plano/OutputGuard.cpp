@@ -45,6 +45,13 @@ bool sameFile(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+std::string CommandPaths::report() const {
+  for (const WrittenFile& output : outputs) {
+    if (output.option == "--report") return output.path;
+  }
+  return {};
+}
+
 void checkCommandPaths(const CommandPaths& paths) {
   for (std::size_t i = 0; i < paths.outputs.size(); ++i) {
     const auto& [option, path] = paths.outputs[i];

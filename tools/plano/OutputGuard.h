@@ -20,6 +20,9 @@ struct CommandPaths {
   std::vector<WrittenFile> outputs;  ///< The result mesh (--output) first.
   bool inPlace = false;              ///< --in-place given: the result mesh may be the mesh itself.
   bool inPlaceOption = false;        ///< The command has --in-place (messages suggest it only then).
+
+  /// The file of --report, or empty.
+  std::string report() const;
 };
 
 /// Throw Error(Usage), before a command runs, when a written file goes to a folder that

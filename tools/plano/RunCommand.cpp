@@ -15,9 +15,10 @@ extern "C" void onInterruptSignal(int) { requestCancellation(); }
 /// `reportsBefore` reports had been written.
 void writeFailureReport(const CommandRun& command, std::size_t reportsBefore, const std::string& status,
                         const std::string& reason, std::ostream& err) {
-  if (command.reportPath.empty() || reportsWritten() != reportsBefore) return;
+  const std::string reportPath = command.paths.report();
+  if (reportPath.empty() || reportsWritten() != reportsBefore) return;
   try {
-    writeReport(command.reportPath, failureReport(command.name, status, reason));
+    writeReport(reportPath, failureReport(command.name, status, reason));
   } catch (const Error& e) {
     err << "plano: could not write the report: " << e.what() << std::endl;
   }

@@ -12,8 +12,8 @@ namespace plano::cli {
 struct CommandRun {
   std::string name;        ///< Sub-command name, for the failure report.
   RunFunction run;
-  std::string reportPath;  ///< --report of the command; empty when not given.
-  /// Checked before the command runs (checkCommandPaths); a usage error when they clash.
+  /// The files it reads and writes (--report among them): checked before it runs
+  /// (checkCommandPaths), a usage error when they clash.
   CommandPaths paths;
 };
 

@@ -149,8 +149,7 @@ int main(int argc, char** argv) {
   try {
     for (auto& [sub, run] : commands) {
       if (!sub->parsed()) continue;
-      const CommandPaths paths = commandPaths(*sub);
-      const CommandRun command{sub->get_name(), run, paths.outputs.back().path /* --report */, paths};
+      const CommandRun command{sub->get_name(), run, commandPaths(*sub)};
       return runCommand(command, options, std::cerr);
     }
     return plano::exitCode(plano::ErrorKind::Usage);
