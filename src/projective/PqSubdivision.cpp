@@ -54,7 +54,8 @@ void requireMemoryForLevels(const FaceList& base, const PqSubdivisionSettings& s
   for (int level = 2; level <= settings.levels; ++level) finestFaces *= 4.0;
   std::ostringstream what;
   what << "subdividing " << base.size() << " faces " << settings.levels << " times (" << std::fixed
-       << std::setprecision(0) << finestFaces << " faces at the finest level" << (settings.planarize ? ", planarized" : "") << ")";
+       << std::setprecision(0) << finestFaces << " faces at the finest level"
+       << (settings.planarize ? ", planarized" : "") << ")";
   requireMemory(finestFaces * (settings.planarize ? kPlanarizedBytesPerFinestFace : kLinearBytesPerFinestFace),
                 what.str(), settings.memoryLimitBytes);
 }
