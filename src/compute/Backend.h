@@ -118,6 +118,10 @@ struct LinearSolverSettings {
   /// Iterative solvers: rows per block of the block-Jacobi preconditioner (1 to 4, dividing
   /// A's size; 1: Jacobi), as AdmmSettings::preconditionerBlock. Direct solvers ignore it.
   int preconditionerBlock = 1;
+  /// Direct solvers: the most bytes their factor may take, checked after the symbolic
+  /// analysis and before the factor is computed (OutOfMemory above it); 0: the memory
+  /// available (core/Memory.h).
+  std::uint64_t memoryLimitBytes = 0;
 };
 
 /// What the last solve did.
@@ -148,6 +152,10 @@ class SpdSolver {
   /// use it; direct solvers ignore it) and the solution on exit.
   virtual LinearSolveInfo solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
   virtual Eigen::Index size() const = 0;
+  /// Bytes a direct solver's factorization takes at its peak, as estimated from its
+  /// symbolic analysis before the factor was computed (what LinearSolverSettings::
+  /// memoryLimitBytes is checked against); 0 for a solver that does not factor.
+  virtual double factorBytes() const { return 0.0; }
   /// Replace A by a matrix with the same sparsity pattern (precondition) and factor or
   /// upload it again, reusing what depends on the pattern only (a direct solver's ordering
   /// and symbolic analysis). Returns false when this solver cannot; the caller then creates

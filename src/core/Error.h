@@ -37,6 +37,14 @@ class Error : public std::runtime_error {
   ErrorKind kind_;
 };
 
+/// A result refused before it was allocated because it cannot fit in memory (core/Memory.h):
+/// a numerical failure to the tool, but one that no fallback with the same matrices avoids,
+/// so fallbacks rethrow it rather than trying again.
+class OutOfMemory : public Error {
+ public:
+  explicit OutOfMemory(const std::string& message) : Error(ErrorKind::Numerical, message) {}
+};
+
 [[noreturn]] inline void throwBadInput(const std::string& message) { throw Error(ErrorKind::BadInput, message); }
 [[noreturn]] inline void throwNumerical(const std::string& message) { throw Error(ErrorKind::Numerical, message); }
 [[noreturn]] inline void throwDevice(const std::string& message) { throw Error(ErrorKind::Device, message); }

@@ -16,12 +16,18 @@ namespace plano {
 /// neither is known.
 std::optional<std::uint64_t> availableMemoryBytes();
 
-/// What a memory control group mounted at `root` still allows (limit minus usage; cgroup v2
-/// memory.max and memory.current, or v1 memory/memory.limit_in_bytes and
-/// memory/memory.usage_in_bytes); nullopt without a limit.
-std::optional<std::uint64_t> controlGroupHeadroom(const std::filesystem::path& root = "/sys/fs/cgroup");
+/// What the memory control groups of a process still allow: the least headroom (limit
+/// minus usage) over its own group and every group above it, which all bound it. Read in
+/// the cgroup v2 tree at `root` (memory.max, memory.current) and in v1's memory controller
+/// at `root`/memory (memory.limit_in_bytes, memory.usage_in_bytes). `membership` is the
+/// process's /proc/self/cgroup ("0::/a/b" names its v2 group, "4:memory:/a/b" its v1
+/// memory group); a group whose folder is not there (a container that mounts its own group
+/// as the root) is read at the root. nullopt without any limit.
+std::optional<std::uint64_t> controlGroupHeadroom(const std::filesystem::path& root, const std::string& membership);
+/// The same for this process (/sys/fs/cgroup, /proc/self/cgroup).
+std::optional<std::uint64_t> controlGroupHeadroom();
 
-/// Throws Error(Numerical) "out of memory: `what` needs X GiB, ..." when `bytes` exceed
+/// Throws OutOfMemory (an Error(Numerical)) "out of memory: `what` needs X GiB, ..." when `bytes` exceed
 /// `limit`, or with limit 0 the memory available (no check where that is unknown).
 void requireMemory(double bytes, const std::string& what, std::uint64_t limit = 0);
 

@@ -472,6 +472,8 @@ BoxQpSolver::ActiveSetSolve BoxQpSolver::solveActiveSet(const std::vector<char>&
         created = backend_.createSpdSolver(K, linear);
         solver = created.get();
       }
+    } catch (const OutOfMemory&) {
+      throw;  // the ADMM's K, with C's whole pattern, would not fit either
     } catch (const Error&) {
       return result;
     }

@@ -20,7 +20,7 @@ class VulkanDeformCommand : public ::testing::Test {
     std::ofstream(dir_ / "c.json") << R"({"fixed": [0, 1, 2, 3, 4],
                                            "handles": [{"vertex": 24, "position": [1.0, 1.0, 0.3]}]})";
   }
-  std::string path(const std::string& name) const { return "\"" + (dir_ / name).string() + "\""; }
+  std::string path(const std::string& name) const { return quotedPath(dir_ / name); }
   nlohmann::json deform(const std::string& backend) const {
     const ToolResult result = runTool("-q --backend " + backend + " deform " + path("grid.obj") + " --constraints " +
                                       path("c.json") + " -o " + path(backend + ".obj") + " --report " +

@@ -23,7 +23,7 @@ class VulkanSubspaceCommand : public ::testing::Test {
     std::ofstream(dir_ / "c.json") << R"({"fixed": [0, 1, 2, 3, 4, 5, 6, 7, 8, 9],
                                            "handles": [{"vertex": 40, "position": [0.0, 0.0, 1.2]}]})";
   }
-  std::string path(const std::string& name) const { return "\"" + (dir_ / name).string() + "\""; }
+  std::string path(const std::string& name) const { return quotedPath(dir_ / name); }
   ToolResult deform(const std::string& backend, const std::string& out, const std::string& report) const {
     return runTool("-q --backend " + backend + " deform " + path("dome.obj") + " --space vertical --constraints " +
                    path("c.json") + " -o " + path(out) + " --report " + path(report));

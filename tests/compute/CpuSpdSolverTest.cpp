@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 
 #include "compute/MeshMatrices.h"
 #include "compute/cpu/CpuBackend.h"
+#include "core/Error.h"
 #include "mesh/Generators.h"
 
 namespace plano::test {
@@ -49,6 +51,32 @@ TEST(CpuSpdSolver, WithoutTheResidualItGivesTheSameSolutionAndStillFlagsNonFinit
   bad(3, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(unmeasured->solve(bad, Y).converged);
   EXPECT_FALSE(measured->solve(bad, X).converged);
+}
+
+TEST(CpuSpdSolver, AFactorLargerThanItsMemoryLimitIsRefusedNamingItsMatrixBeforeItIsComputed) {
+  const System s = meshSystem();
+  const Eigen::Index n = s.A.rows();
+  // L holds at least A's lower triangle, at most a dense triangle (plus CHOLMOD's
+  // largest update matrix, at most n x n): the estimate lies between.
+  const compute::SparseMatrix lower = s.A.triangularView<Eigen::Lower>();
+  compute::LinearSolverSettings settings;
+  settings.memoryLimitBytes = static_cast<std::uint64_t>(lower.nonZeros()) * sizeof(double) - 1;
+  compute::CpuBackend cpu;
+  try {
+    cpu.createSpdSolver(s.A, settings);
+    ADD_FAILURE() << "no error";
+  } catch (const OutOfMemory& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    const std::string message = e.what();
+    EXPECT_NE(message.find("the Cholesky factor of a sparse " + std::to_string(n) + " x " + std::to_string(n) +
+                           " matrix (" + std::to_string(s.A.nonZeros()) + " nonzeros)"),
+              std::string::npos)
+        << message;
+  }
+  settings.memoryLimitBytes = static_cast<std::uint64_t>(2 * n * n) * sizeof(double);
+  auto solver = cpu.createSpdSolver(s.A, settings);
+  Eigen::MatrixXd X;
+  EXPECT_TRUE(solver->solve(s.B, X).converged);
 }
 
 }  // namespace

@@ -244,6 +244,17 @@ TEST(BoxQp, ADirectSolveThatCannotFactorFallsBackToTheAdmm) {
   EXPECT_LT((qp.C * x - qp.d).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+TEST(BoxQp, ADirectSolveWhoseFactorCannotFitIsRefusedWithoutAnAdmmAttempt) {
+  // The ADMM's K has the same pattern: a fallback would only be refused again, later.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 19);
+  CountingBackend counting;
+  BoxQpSettings settings;
+  settings.linearSolver.memoryLimitBytes = 64;  // bytes: less than any factor of 12 rows
+  Eigen::MatrixXd x, y;
+  EXPECT_THROW(solveOnNewSolver(counting, qp, settings, x, y), OutOfMemory);
+  EXPECT_EQ(counting.created, 1);
+}
+
 TEST(BoxQp, ProblemsWithInequalityRowsTakeTheAdmmEvenWhenDirectIsAsked) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 9);
   Eigen::MatrixXd upper = qp.d;

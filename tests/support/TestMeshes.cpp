@@ -50,6 +50,13 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+std::string quotedPath(const std::filesystem::path& path) {
+  std::string quoted = "\"";
+  quoted += path.string();
+  quoted += '"';
+  return quoted;
+}
+
 ToolResult runTool(const std::string& arguments) {
   TempDir dir;
   const auto out = dir / "stdout";

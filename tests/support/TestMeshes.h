@@ -55,5 +55,7 @@ struct ToolResult {
   std::string err;
 };
 ToolResult runTool(const std::string& arguments);
+/// `path` in double quotes: one word of runTool's arguments even with spaces in it.
+std::string quotedPath(const std::filesystem::path& path);
 
 }  // namespace plano::test

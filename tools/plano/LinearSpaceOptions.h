@@ -4,6 +4,7 @@
 // register them here, so that each takes the same three with the same meaning.
 #include <CLI/CLI.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plano/Command.h"
@@ -13,7 +14,10 @@
 namespace plano::cli {
 
 struct LinearSpaceOptions {
-  std::string space = "affine";  ///< affine | parallel | vertical | mixed; empty: not given (deform).
+  /// `defaultSpace` is --space's value when it is not given ("": none, as in deform).
+  explicit LinearSpaceOptions(std::string defaultSpace = "affine") : space(std::move(defaultSpace)) {}
+
+  std::string space;             ///< affine | parallel | vertical | mixed; empty: not given (deform).
   std::string facesFile;         ///< Per-face types of a mixed space (subspace/FaceAssignmentIO.h).
   std::vector<double> up{0.0, 0.0, 1.0};  ///< The vertical direction of vertical faces.
 

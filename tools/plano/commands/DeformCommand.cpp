@@ -43,7 +43,7 @@ struct DeformOptions {
   std::string scheme = "catmull-clark";
   int multiresLevel = -1;
   // --space (linear-spaces paper §3): deformation inside a linear space of polyhedral meshes.
-  LinearSpaceOptions linearSpace = {.space = ""};  ///< --space not given: the projective shape space.
+  LinearSpaceOptions linearSpace{""};  ///< --space not given: the projective shape space.
   const CLI::Option* smoothnessOption = nullptr;  ///< Tells whether --smoothness was given.
   const CLI::Option* toleranceOption = nullptr;   ///< Tells whether --tolerance was given.
   const CLI::Option* maxIterationsOption = nullptr;

@@ -23,7 +23,7 @@ using namespace plano::subspace;
 
 struct DualOptions {
   std::string input, output, report, primal;
-  LinearSpaceOptions linearSpace = {.space = "parallel"};  ///< Of the dual; not mixed.
+  LinearSpaceOptions linearSpace{"parallel"};  ///< Of the dual; not mixed.
   Index eigenshape = 3;
   double amplitude = 0.05;
   bool keepPartial = false;
