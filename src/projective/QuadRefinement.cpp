@@ -9,7 +9,15 @@
 namespace plano::projective {
 namespace {
 
-std::string edgeName(Index a, Index b) { return "(" + std::to_string(a) + ", " + std::to_string(b) + ")"; }
+std::string edgeName(Index a, Index b) {
+  // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "(" + std::to_string(a).
+  std::string name = "(";
+  name += std::to_string(a);
+  name += ", ";
+  name += std::to_string(b);
+  name += ')';
+  return name;
+}
 
 void checkFaces(const FaceList& faces, Index vertexCount) {
   for (Index f = 0; f < faces.size(); ++f) {

@@ -49,12 +49,7 @@ Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance
   qr.compute(At);
   if (qr.info() != Eigen::Success) throwNumerical("sparse QR of the constraint matrix failed");
   rank = static_cast<Index>(qr.rank());
-  // The selector and N, both n x (n - rank), live at once.
-  const double basisBytes = static_cast<double>(n) * static_cast<double>(n - rank) * sizeof(double);
-  requireMemory(2.0 * basisBytes,
-                "the null-space basis (" + std::to_string(n) + " unknowns x " + std::to_string(n - rank) +
-                    " dimensions, formed from a selector of its size)",
-                memoryLimit);
+  requireBasisMemory(n, n - rank, /*atLeast=*/false, memoryLimit);
   Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(n, n - rank);
   selector.bottomRows(n - rank).setIdentity();
   Eigen::MatrixXd N;
@@ -63,6 +58,17 @@ Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance
 }
 
 }  // namespace
+
+void requireBasisMemory(Index unknowns, Index dimension, bool atLeast, std::uint64_t limit) {
+  if (dimension <= 0) return;
+  // The selector and N, both unknowns x dimension, live at once.
+  const double basisBytes = static_cast<double>(unknowns) * static_cast<double>(dimension) * sizeof(double);
+  requireMemory(2.0 * basisBytes,
+                "the null-space basis (" + std::to_string(unknowns) + " unknowns x " + (atLeast ? "at least " : "") +
+                    std::to_string(dimension) + " dimensions" + (atLeast ? ", the topological lower bound" : "") +
+                    ", formed from a selector of its size)",
+                limit);
+}
 
 SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettings& settings, BasisInfo* info) {
   const Index unknowns = static_cast<Index>(B.matrix.cols());

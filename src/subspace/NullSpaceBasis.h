@@ -29,8 +29,9 @@ struct BasisSettings {
   /// Memory the dense basis may take while it is formed (bytes; 0: what the system has
   /// available). The basis is #unknowns x dim null(B) doubles, formed from a selector of
   /// the same size: on a large mesh it outgrows the machine (a 1M-quad grid's affine space,
-  /// ~2 000 scalar columns, would need ~32 GiB), and is refused with Error(Numerical) once
-  /// the sparse QR has given its dimension, before anything that size is allocated.
+  /// ~2 000 scalar columns, would need ~32 GiB), and is refused with OutOfMemory before
+  /// anything that size is allocated: by buildLinearSpace before the sparse QR when the
+  /// topological lower bound's columns cannot fit, else once the QR has given the dimension.
   std::uint64_t memoryLimitBytes = 0;
 };
 
@@ -44,6 +45,11 @@ struct BasisInfo {
   // N's orthogonality is not measured here: max |N^T N - I| costs #V d^2, minutes on a
   // space of ten thousand dimensions (SubspaceBasis::orthogonalityError, for tests).
 };
+
+/// Throws OutOfMemory when a dense basis of `unknowns` x `dimension` stored columns,
+/// formed from a selector of its size, exceeds `limit` (0: the memory available).
+/// `atLeast`: `dimension` is a lower bound (checked before the factorization that gives it).
+void requireBasisMemory(Index unknowns, Index dimension, bool atLeast, std::uint64_t limit);
 
 /// Orthonormal basis of null(B). Throws Error(Numerical) when the factorization fails.
 SubspaceBasis computeNullSpaceBasis(const ConstraintMatrix& B, const BasisSettings& settings = {},

@@ -187,28 +187,38 @@ TEST(LinearSpace, SparseQrAndDenseSvdAgreeOnTheDimension) {
 }
 
 TEST(LinearSpace, ABasisLargerThanItsMemoryLimitIsRefusedNamingItsSize) {
-  // The 6x5 grid's parallel space: 126 unknowns and its dimension, in a basis and a
-  // selector of 8 bytes an entry. Refused under a limit below that, before it is formed;
-  // built under one above.
-  const PolygonMesh mesh = generate::translationalSurface(6, 5);
+  // A surface of revolution's parallel space: 3 #V unknowns, dimension 41 above its
+  // topological lower bound 36, in a basis and a selector of 8 bytes an entry. Under a
+  // limit below the bound's columns it is refused before the sparse QR, naming the bound;
+  // under one between the two, once the QR has given the dimension; above, built.
+  const PolygonMesh mesh = generate::surfaceOfRevolution(12, 6);
   const auto spaces = uniformAssignment(SpaceKind::Parallel, mesh.faceCount());
   LinearSpaceSettings settings;
   settings.basis.method = BasisMethod::SparseQr;
-  const Index dimension = buildLinearSpace(mesh, spaces, settings).N.dimension();
-  const auto needed = static_cast<std::uint64_t>(2 * 126 * dimension * sizeof(double));
-  settings.basis.memoryLimitBytes = needed - 1;
-  try {
-    buildLinearSpace(mesh, spaces, settings);
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Numerical);
-    const std::string message = e.what();
-    EXPECT_NE(message.find("out of memory: the null-space basis (126 unknowns x " + std::to_string(dimension) +
-                           " dimensions"),
-              std::string::npos)
-        << message;
-  }
-  settings.basis.memoryLimitBytes = needed;
+  const LinearSpace space = buildLinearSpace(mesh, spaces, settings);
+  const Index unknowns = 3 * mesh.vertexCount();
+  const Index dimension = space.N.dimension();
+  const Index bound = space.dof.lowerBound;
+  ASSERT_LT(bound, dimension);
+  ASSERT_GT(bound, 0);
+  const auto bytes = [&](Index columns) { return static_cast<std::uint64_t>(2 * unknowns * columns * sizeof(double)); };
+  const auto refusal = [&](std::uint64_t limit) {
+    settings.basis.memoryLimitBytes = limit;
+    try {
+      buildLinearSpace(mesh, spaces, settings);
+    } catch (const OutOfMemory& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string unknownsText = "out of memory: the null-space basis (" + std::to_string(unknowns) + " unknowns x ";
+  std::string message = refusal(bytes(bound) - 1);
+  EXPECT_NE(message.find(unknownsText + "at least " + std::to_string(bound) + " dimensions, the topological lower bound"),
+            std::string::npos)
+      << message;
+  message = refusal(bytes(dimension) - 1);
+  EXPECT_NE(message.find(unknownsText + std::to_string(dimension) + " dimensions, formed"), std::string::npos) << message;
+  settings.basis.memoryLimitBytes = bytes(dimension);
   EXPECT_EQ(buildLinearSpace(mesh, spaces, settings).N.dimension(), dimension);
 }
 
