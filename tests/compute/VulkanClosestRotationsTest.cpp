@@ -4,43 +4,12 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "compute/KernelComparisons.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
 
 namespace plano::test {
 namespace {
-
-struct RotationComparison {
-  double rotations = 0.0;
-  double singularValues = 0.0;  ///< Relative to the largest singular value of the matrix.
-  double orthogonality = 0.0;   ///< Largest |R^T R - I| of the device results.
-  double determinant = 0.0;     ///< Largest |det R - 1|.
-};
-
-RotationComparison compare(compute::Backend& backend, const std::vector<Eigen::Matrix3d>& matrices) {
-  const std::size_t n = matrices.size();
-  std::vector<Eigen::Matrix3d> gpuR(n), cpuR(n);
-  std::vector<Eigen::Vector3d> gpuS(n), cpuS(n);
-  backend.closestRotations(matrices, gpuR, gpuS);
-  compute::CpuBackend().closestRotations(matrices, cpuR, cpuS);
-  RotationComparison c;
-  for (std::size_t i = 0; i < n; ++i) {
-    c.rotations = std::max(c.rotations, (gpuR[i] - cpuR[i]).cwiseAbs().maxCoeff());
-    c.singularValues =
-        std::max(c.singularValues, (gpuS[i] - cpuS[i]).cwiseAbs().maxCoeff() / std::max(cpuS[i][0], 1e-300));
-    c.orthogonality = std::max(c.orthogonality,
-                               (gpuR[i].transpose() * gpuR[i] - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
-    c.determinant = std::max(c.determinant, std::abs(gpuR[i].determinant() - 1.0));
-  }
-  return c;
-}
-
-void expectAgreement(const RotationComparison& c) {
-  EXPECT_LT(c.rotations, 1e-10);
-  EXPECT_LT(c.singularValues, 1e-10);
-  EXPECT_LT(c.orthogonality, 1e-12);
-  EXPECT_LT(c.determinant, 1e-12);
-}
 
 class VulkanClosestRotations : public VulkanTest {};
 
@@ -49,7 +18,7 @@ TEST_F(VulkanClosestRotations, MatchesCpuOnRandomMatrices) {
   std::normal_distribution<double> g;
   std::vector<Eigen::Matrix3d> matrices(5000);
   for (auto& m : matrices) m = Eigen::Matrix3d::NullaryExpr([&](Eigen::Index, Eigen::Index) { return g(rng); });
-  expectAgreement(compare(backend(), matrices));
+  expectRotationAgreement(compareRotations(backend(), matrices));
 }
 
 TEST_F(VulkanClosestRotations, ReflectionsGetANegativeThirdSingularValue) {
@@ -62,7 +31,7 @@ TEST_F(VulkanClosestRotations, ReflectionsGetANegativeThirdSingularValue) {
   EXPECT_LT((R[0] - Eigen::Matrix3d::Identity()).norm(), 1e-14);
   EXPECT_NEAR(R[1].determinant(), 1.0, 1e-14);
   EXPECT_LT(S[1][2], 0.0);
-  expectAgreement(compare(backend(), matrices));
+  expectRotationAgreement(compareRotations(backend(), matrices));
 }
 
 TEST_F(VulkanClosestRotations, NearRotationsAndRankDeficientMatricesStayProperRotations) {
@@ -76,7 +45,7 @@ TEST_F(VulkanClosestRotations, NearRotationsAndRankDeficientMatricesStayProperRo
     const Eigen::Vector3d a(g(rng), g(rng), g(rng)), b(g(rng), g(rng), g(rng)), c(g(rng), g(rng), g(rng));
     matrices.push_back(a * b.transpose() + c * a.transpose());                   // rank 2
   }
-  expectAgreement(compare(backend(), matrices));
+  expectRotationAgreement(compareRotations(backend(), matrices));
 }
 
 TEST_F(VulkanClosestRotations, EmptyBatchIsFine) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "compute/KernelComparisons.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
 #include "compute/vulkan/VulkanFacePlanarity.h"
@@ -14,19 +15,6 @@
 
 namespace plano::test {
 namespace {
-
-/// Largest |vulkan - cpu| / max(|cpu|, 1) over the faces; planarity is in percent, so
-/// the floor of 1 makes exactly planar faces (values at rounding level) compare absolutely.
-double worstRelativeDifference(compute::Backend& backend, const PolygonMesh& mesh) {
-  std::vector<double> gpu(mesh.faceCount()), cpu(mesh.faceCount());
-  backend.facePlanarity(mesh, gpu);
-  compute::CpuBackend().facePlanarity(mesh, cpu);
-  double worst = 0.0;
-  for (Index f = 0; f < mesh.faceCount(); ++f) {
-    worst = std::max(worst, std::abs(gpu[f] - cpu[f]) / std::max(std::abs(cpu[f]), 1.0));
-  }
-  return worst;
-}
 
 /// Random polygon soup: faces of 3..7 distinct random vertices of random positions.
 PolygonMesh randomPolygons(Index vertexCount, Index faceCount, unsigned seed) {
@@ -48,22 +36,22 @@ PolygonMesh randomPolygons(Index vertexCount, Index faceCount, unsigned seed) {
 class VulkanFacePlanarity : public VulkanTest {};
 
 TEST_F(VulkanFacePlanarity, MatchesCpuOnRandomPolygons) {
-  EXPECT_LT(worstRelativeDifference(backend(), randomPolygons(200, 3000, 1)), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), randomPolygons(200, 3000, 1)), 1e-12);
 }
 
 TEST_F(VulkanFacePlanarity, MatchesCpuOnGeneratedQuadMeshes) {
-  EXPECT_LT(worstRelativeDifference(backend(), generate::translationalSurface(40, 30)), 1e-12);
-  EXPECT_LT(worstRelativeDifference(backend(), generate::surfaceOfRevolution(32, 12)), 1e-12);
-  EXPECT_LT(worstRelativeDifference(backend(), generate::hyparGrid(50, 0.7)), 1e-12);
-  EXPECT_LT(worstRelativeDifference(backend(), generate::cube()), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::translationalSurface(40, 30)), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::surfaceOfRevolution(32, 12)), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::hyparGrid(50, 0.7)), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::cube()), 1e-12);
 }
 
 TEST_F(VulkanFacePlanarity, MatchesCpuOnPentagonsAndHexagons) {
-  EXPECT_LT(worstRelativeDifference(backend(), generate::dodecahedron()), 1e-12);
-  EXPECT_LT(worstRelativeDifference(backend(), generate::hexagonalDome(12)), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::dodecahedron()), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), generate::hexagonalDome(12)), 1e-12);
   PolygonMesh noisy = generate::hexagonalDome(10);
   noisy.vertices = perturbed(noisy.vertices, 0.01);
-  EXPECT_LT(worstRelativeDifference(backend(), noisy), 1e-12);
+  EXPECT_LT(planarityDifference(backend(), noisy), 1e-12);
 }
 
 TEST_F(VulkanFacePlanarity, NonPlanarFacesHaveTheCpuValuesNotJustZero) {
@@ -124,7 +112,7 @@ TEST_F(VulkanFaceChecks, RepeatedCallsOnMeshesOfDifferentSizesReuseBuffersCorrec
   // must neither read stale data nor overrun.
   for (Index n : {30, 4, 17, 45}) {
     PolygonMesh mesh = generate::hyparGrid(n, 0.3);
-    EXPECT_LT(worstRelativeDifference(backend(), mesh), 1e-12) << "n " << n;
+    EXPECT_LT(planarityDifference(backend(), mesh), 1e-12) << "n " << n;
     compute::ProjectiveFits gpu, cpu;
     const Positions target = perturbed(mesh.vertices, 0.01, static_cast<unsigned>(n));
     backend().fitProjectiveMaps(mesh.faces, mesh.vertices, target, gpu);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "compute/KernelComparisons.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
@@ -18,32 +19,6 @@
 
 namespace plano::test {
 namespace {
-
-struct IdealComparison {
-  double maps = 0.0;           ///< Largest |difference| / max(1, |entry|) over map entries.
-  int methodMismatches = 0;
-  Index fallbacks = 0;         ///< CPU faces with the corner-set Procrustes.
-  double largestRotation = 0.0;  ///< max |R - I| of the CPU maps' linear parts (a non-trivial example).
-};
-
-IdealComparison compare(compute::Backend& backend, const FaceList& faces, const Positions& source,
-                        const std::vector<Eigen::Matrix4d>& fitted, const Positions* target, bool similar) {
-  compute::IdealMaps gpu, cpu;
-  backend.closestIdealMaps(faces, source, fitted, target, similar, gpu);
-  compute::CpuBackend().closestIdealMaps(faces, source, fitted, target, similar, cpu);
-  IdealComparison c;
-  for (Index f = 0; f < faces.size(); ++f) {
-    for (int e = 0; e < 16; ++e) {
-      const double a = gpu.maps[f].data()[e], b = cpu.maps[f].data()[e];
-      c.maps = std::max(c.maps, std::abs(a - b) / std::max(1.0, std::abs(b)));
-    }
-    if (gpu.methods[f] != cpu.methods[f]) ++c.methodMismatches;
-    if (cpu.methods[f] == compute::IdealMapMethod::CornerProcrustes) ++c.fallbacks;
-    c.largestRotation = std::max(
-        c.largestRotation, (cpu.maps[f].topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
-  }
-  return c;
-}
 
 /// The CPU fits of `target` (world) from the base mesh, in the shape space's coordinates.
 struct Fitted {
@@ -70,7 +45,7 @@ TEST_F(VulkanIdealMaps, AgreeWithTheCpuOnPerspectiveFitsOfHexagonsRigidAndSimila
   const Fitted f = fit(mesh, target);
   for (const bool similar : {false, true}) {
     for (const Positions* t : {static_cast<const Positions*>(nullptr), &f.normalizedTarget}) {
-      const IdealComparison c = compare(backend(), mesh.faces, f.space.basePositions(), f.maps, t, similar);
+      const IdealComparison c = compareIdealMaps(backend(), mesh.faces, f.space.basePositions(), f.maps, t, similar);
       EXPECT_LT(c.maps, 1e-10) << "similar " << similar << ", target " << (t != nullptr);
       EXPECT_EQ(c.methodMismatches, 0);
       EXPECT_GT(c.largestRotation, 1e-2);  // the fits are not near the identity
@@ -84,7 +59,7 @@ TEST_F(VulkanIdealMaps, AgreeWithTheCpuOnFitsOfRandomlyMovedNonPlanarQuads) {
     const Fitted f = fit(mesh, rotatedScaledAndPerturbed(mesh.vertices, 1.4, 0.02, seed));
     for (const bool similar : {false, true}) {
       const IdealComparison c =
-          compare(backend(), mesh.faces, f.space.basePositions(), f.maps, &f.normalizedTarget, similar);
+          compareIdealMaps(backend(), mesh.faces, f.space.basePositions(), f.maps, &f.normalizedTarget, similar);
       EXPECT_LT(c.maps, 1e-10) << "seed " << seed << ", similar " << similar;
       EXPECT_EQ(c.methodMismatches, 0);
       EXPECT_GT(c.largestRotation, 0.1);
@@ -107,7 +82,7 @@ TEST_F(VulkanIdealMaps, FitsThroughThePlaneAtInfinityFallBackToCornerProcrustesA
     broken[face](3, 3) = 1.0 - 1e3 * (b - a).dot(0.5 * (a + b));
   }
   for (const bool similar : {false, true}) {
-    const IdealComparison c = compare(backend(), mesh.faces, p, broken, &f.normalizedTarget, similar);
+    const IdealComparison c = compareIdealMaps(backend(), mesh.faces, p, broken, &f.normalizedTarget, similar);
     EXPECT_LT(c.maps, 1e-10) << "similar " << similar;
     EXPECT_EQ(c.methodMismatches, 0);
     EXPECT_EQ(c.fallbacks, (mesh.faces.size() + 1) / 2);
@@ -121,7 +96,7 @@ TEST_F(VulkanIdealMaps, FitsThroughThePlaneAtInfinityFallBackToCornerProcrustesA
   atInfinity[1] = Eigen::Matrix4d::Identity();
   atInfinity[1].block<3, 1>(0, 3) = Eigen::Vector3d(1.0, 0.0, 0.0);
   atInfinity[1](3, 3) = -centroid.x();  // w(centroid) = x - x = 0
-  const IdealComparison none = compare(backend(), mesh.faces, p, atInfinity, nullptr, false);
+  const IdealComparison none = compareIdealMaps(backend(), mesh.faces, p, atInfinity, nullptr, false);
   EXPECT_EQ(none.methodMismatches, 0);
   compute::IdealMaps gpu;
   backend().closestIdealMaps(mesh.faces, p, atInfinity, nullptr, false, gpu);
@@ -163,7 +138,7 @@ TEST_F(VulkanIdealMaps, TheFitsOfTheLastLocalStepAndTheirTargetAreNotUploadedAga
   // A later local step on this backend, then its ideal maps.
   const projective::LocalStepResult fit = projective::fitFaceMaps(backend(), space, target);
   const vk::TransferCounts before = context().transfers();
-  const IdealComparison c = compare(backend(), mesh.faces, space.basePositions(), fit.fits.maps, &normalized, false);
+  const IdealComparison c = compareIdealMaps(backend(), mesh.faces, space.basePositions(), fit.fits.maps, &normalized, false);
   const vk::TransferCounts after = context().transfers();
   EXPECT_LT(c.maps, 1e-10);
   EXPECT_EQ(c.methodMismatches, 0);
@@ -171,7 +146,7 @@ TEST_F(VulkanIdealMaps, TheFitsOfTheLastLocalStepAndTheirTargetAreNotUploadedAga
   // Other maps than the fit's are uploaded, and the result is theirs.
   std::vector<Eigen::Matrix4d> other = fit.fits.maps;
   other[3](0, 1) += 0.05;
-  const IdealComparison changed = compare(backend(), mesh.faces, space.basePositions(), other, &normalized, false);
+  const IdealComparison changed = compareIdealMaps(backend(), mesh.faces, space.basePositions(), other, &normalized, false);
   EXPECT_LT(changed.maps, 1e-10);
   EXPECT_EQ(context().transfers().uploadedBytes - after.uploadedBytes, static_cast<std::uint64_t>(mesh.faces.size()) * 128u);
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "compute/KernelComparisons.h"
 #include "compute/VulkanFixture.h"
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
@@ -14,45 +15,6 @@
 
 namespace plano::test {
 namespace {
-
-struct FitComparison {
-  double maps = 0.0;       ///< Largest |difference| / max(1, |entry|) over map entries.
-  double scales = 0.0;     ///< Same for the reciprocal scales.
-  double residuals = 0.0;  ///< Largest absolute difference of RMS residuals.
-  int rankMismatches = 0;
-  Index faces = 0;
-  double largestResidual = 0.0;  ///< Of the CPU fits (to know an example is not trivial).
-};
-
-FitComparison compare(compute::Backend& backend, const FaceList& faces, const Positions& source,
-                      const Positions& target) {
-  compute::ProjectiveFits gpu, cpu;
-  backend.fitProjectiveMaps(faces, source, target, gpu);
-  compute::CpuBackend().fitProjectiveMaps(faces, source, target, cpu);
-  FitComparison c;
-  c.faces = faces.size();
-  for (Index f = 0; f < faces.size(); ++f) {
-    for (int e = 0; e < 16; ++e) {
-      const double a = gpu.maps[f].data()[e], b = cpu.maps[f].data()[e];
-      c.maps = std::max(c.maps, std::abs(a - b) / std::max(1.0, std::abs(b)));
-    }
-    c.residuals = std::max(c.residuals, std::abs(gpu.residuals[f] - cpu.residuals[f]));
-    c.largestResidual = std::max(c.largestResidual, cpu.residuals[f]);
-    if (gpu.ranks[f] != cpu.ranks[f]) ++c.rankMismatches;
-  }
-  for (std::size_t i = 0; i < cpu.reciprocalScales.size(); ++i) {
-    const double a = gpu.reciprocalScales[i], b = cpu.reciprocalScales[i];
-    c.scales = std::max(c.scales, std::abs(a - b) / std::max(1.0, std::abs(b)));
-  }
-  return c;
-}
-
-void expectAgreement(const FitComparison& c) {
-  EXPECT_LT(c.maps, 1e-10);
-  EXPECT_LT(c.scales, 1e-10);
-  EXPECT_LT(c.residuals, 1e-10);
-  EXPECT_EQ(c.rankMismatches, 0) << "of " << c.faces << " faces";
-}
 
 /// A projective map in the row-vector convention that keeps w > 0 on the unit box.
 Eigen::Matrix4d mildProjectiveMap() {
@@ -81,20 +43,20 @@ TEST_F(VulkanProjectiveFit, IdentityTargetGivesIdentityMapsOnPlanarQuads) {
   for (Index f = 0; f < mesh.faceCount(); ++f) {
     EXPECT_LT((fits.maps[f] - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff(), 1e-12) << "face " << f;
   }
-  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, mesh.vertices));
+  expectFitAgreement(compareFits(backend(), mesh.faces, mesh.vertices, mesh.vertices));
 }
 
 TEST_F(VulkanProjectiveFit, MatchesCpuOnProjectivelyMappedQuads) {
   const PolygonMesh mesh = generate::surfaceOfRevolution(12, 5, 0.5, 1.0);
-  const FitComparison c = compare(backend(), mesh.faces, mesh.vertices, applyMap(mesh.vertices, mildProjectiveMap()));
-  expectAgreement(c);
+  const FitComparison c = compareFits(backend(), mesh.faces, mesh.vertices, applyMap(mesh.vertices, mildProjectiveMap()));
+  expectFitAgreement(c);
 }
 
 TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedQuads) {
   // After projection onto their planes, four corners always admit an exact map.
   const PolygonMesh mesh = generate::translationalSurface(5, 5);
   const Positions target = perturbed(applyMap(mesh.vertices, mildProjectiveMap()), 0.02, 3);
-  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, target));
+  expectFitAgreement(compareFits(backend(), mesh.faces, mesh.vertices, target));
 }
 
 TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedHexagons) {
@@ -104,8 +66,8 @@ TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedHexagons) {
   // the order of the perturbation and whose reciprocal scales stay near 1.
   const PolygonMesh dome = generate::hexagonalDome(3);
   const Positions target = perturbed(dome.vertices, 0.01, 9);
-  const FitComparison c = compare(backend(), dome.faces, dome.vertices, target);
-  expectAgreement(c);
+  const FitComparison c = compareFits(backend(), dome.faces, dome.vertices, target);
+  expectFitAgreement(c);
   EXPECT_GT(c.largestResidual, 1e-5);
   compute::ProjectiveFits gpu;
   backend().fitProjectiveMaps(dome.faces, dome.vertices, target, gpu);
@@ -137,10 +99,10 @@ TEST_F(VulkanProjectiveFit, MatchesCpuOnPerturbedHexagons) {
 
 TEST_F(VulkanProjectiveFit, MatchesCpuOnPentagonsAndHexagons) {
   const PolygonMesh dodecahedron = generate::dodecahedron();
-  expectAgreement(compare(backend(), dodecahedron.faces, dodecahedron.vertices,
+  expectFitAgreement(compareFits(backend(), dodecahedron.faces, dodecahedron.vertices,
                           perturbed(applyMap(dodecahedron.vertices, mildProjectiveMap()), 0.01, 5)));
   const PolygonMesh dome = generate::hexagonalDome(3);
-  expectAgreement(compare(backend(), dome.faces, dome.vertices, applyMap(dome.vertices, mildProjectiveMap())));
+  expectFitAgreement(compareFits(backend(), dome.faces, dome.vertices, applyMap(dome.vertices, mildProjectiveMap())));
 }
 
 TEST_F(VulkanProjectiveFit, MatchesCpuOnRandomTriangles) {
@@ -151,7 +113,7 @@ TEST_F(VulkanProjectiveFit, MatchesCpuOnRandomTriangles) {
   mesh.vertices.resize(60, 3);
   for (Index i = 0; i < mesh.vertices.size(); ++i) mesh.vertices.data()[i] = u(rng);
   for (Index f = 0; f < 20; ++f) mesh.faces.addFace({3 * f, 3 * f + 1, 3 * f + 2});
-  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, perturbed(mesh.vertices, 0.05, 2)));
+  expectFitAgreement(compareFits(backend(), mesh.faces, mesh.vertices, perturbed(mesh.vertices, 0.05, 2)));
 }
 
 TEST_F(VulkanProjectiveFit, ARepeatedSourceAndTopologyStayOnTheDeviceAndChangedOnesAreUploaded) {
@@ -161,14 +123,14 @@ TEST_F(VulkanProjectiveFit, ARepeatedSourceAndTopologyStayOnTheDeviceAndChangedO
   compute::ProjectiveFits fits;
   backend().fitProjectiveMaps(mesh.faces, mesh.vertices, first, fits);
   const vk::TransferCounts before = context().transfers();
-  expectAgreement(compare(backend(), mesh.faces, mesh.vertices, second));
+  expectFitAgreement(compareFits(backend(), mesh.faces, mesh.vertices, second));
   const vk::TransferCounts after = context().transfers();
   EXPECT_EQ(after.uploads - before.uploads, 1u);  // the targets only
   EXPECT_EQ(after.uploadedBytes - before.uploadedBytes, static_cast<std::uint64_t>(mesh.vertices.size()) * 8u);
   // A new source, then a new topology, are uploaded, and the fits are theirs.
-  expectAgreement(compare(backend(), mesh.faces, first, second));
+  expectFitAgreement(compareFits(backend(), mesh.faces, first, second));
   const PolygonMesh other = generate::translationalSurface(4, 6);
-  expectAgreement(compare(backend(), other.faces, other.vertices, applyMap(other.vertices, mildProjectiveMap())));
+  expectFitAgreement(compareFits(backend(), other.faces, other.vertices, applyMap(other.vertices, mildProjectiveMap())));
 }
 
 TEST_F(VulkanProjectiveFit, MismatchedPositionArraysAreAUsageError) {
