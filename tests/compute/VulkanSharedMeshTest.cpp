@@ -31,6 +31,11 @@ class VulkanSharedMesh : public VulkanTest, public ::testing::WithParamInterface
   PolygonMesh mesh_;
 };
 
+/// Reads the parameter's mesh into `mesh_`, or skips the test without ../shared/data.
+#define PLANO_LOAD_SHARED_MESH()                  \
+  PLANO_REQUIRE_SHARED_MESH(meshPath, GetParam()); \
+  mesh_ = readMesh(meshPath)
+
 /// Mean over the faces of their bounding-box diagonal: the scale of a local step's motion
 /// of a face (real meshes' faces span a few thousandths of the mesh's diagonal).
 double meanFaceSize(const FaceList& faces, const Positions& positions) {
@@ -51,16 +56,6 @@ double meanFaceSize(const FaceList& faces, const Positions& positions) {
 Positions movedTarget(const PolygonMesh& mesh, const Positions& positions, unsigned seed) {
   return rotatedScaledAndPerturbed(positions, 1.2, 0.05 * meanFaceSize(mesh.faces, positions), seed);
 }
-
-/// Loads the parameter's mesh into `mesh_` or skips the test.
-#define PLANO_LOAD_SHARED_MESH()                                                                  \
-  do {                                                                                            \
-    auto dir = sharedDataDir();                                                                   \
-    if (!dir || !std::filesystem::exists(*dir / GetParam())) {                                    \
-      GTEST_SKIP() << "shared mesh " << GetParam() << " not found (../shared/data is absent)";    \
-    }                                                                                             \
-    mesh_ = readMesh(*dir / GetParam());                                                          \
-  } while (false)
 
 TEST_P(VulkanSharedMesh, PlanarityIsTheCpus) {
   PLANO_LOAD_SHARED_MESH();
@@ -162,6 +157,8 @@ INSTANTIATE_TEST_SUITE_P(Files, VulkanSharedMesh,
                            }
                            return name;
                          });
+
+#undef PLANO_LOAD_SHARED_MESH
 
 }  // namespace
 }  // namespace plano::test
