@@ -12,6 +12,9 @@
 #include "VulkanBenchSupport.h"
 #include "compute/Admm.h"
 #include "compute/Backend.h"
+#include "compute/BlockMultigrid.h"
+#include "compute/vulkan/VulkanMultigrid.h"
+#include "core/Error.h"
 #include "mesh/Generators.h"
 #include "projective/Deformation.h"
 #include "projective/GlobalStep.h"
@@ -187,6 +190,82 @@ plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeS
   return C;
 }
 
+/// One aggregation V-cycle (compute/BlockMultigrid.h, the global step's preconditioner
+/// above 64 faces) for three right-hand sides on the exact step's matrix
+/// K = I + sigma I + rho C^T C of a grid (every row an equality row; rho = 1e3, between the
+/// 0.1 x 1e3 the ADMM's equality rows start at and the few 1e3 they reach): the host reference, one column after the other, or
+/// the device's recorded cycle (vk::Multigrid) with K's levels and block inverses in place.
+/// The device cycle's cost is its dispatches (lavapipe) or its memory traffic (a GPU).
+void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
+  if (!backend) return;
+  plano::bench::MemoryCounters memory(state, backend);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
+  const plano::projective::ShapeSpace space(mesh);
+  const plano::compute::SparseMatrix C = compatibilityMatrix(space, 1);
+  const double sigma = plano::compute::AdmmSettings{}.sigma, rho = 1e3;
+  plano::compute::SparseMatrix K1 = C.transpose() * C;
+  plano::compute::SparseMatrix identity(K1.rows(), K1.cols());
+  identity.setIdentity();
+  plano::compute::SparseMatrix K0 = identity * (1.0 + sigma) + K1 * 0.0;
+  K0.makeCompressed();
+  K1 = K1 + K0 * 0.0;  // on K0's pattern
+  K1.makeCompressed();
+  plano::compute::SparseMatrix K = K0 + K1 * rho;
+  K.makeCompressed();
+  const plano::compute::BlockAggregation aggregation(K, {4});
+  const Eigen::MatrixXd r = plano::bench::jittered(Eigen::MatrixXd::Zero(K.rows(), 3), 1.0);
+  if (choice == BackendChoice::Cpu) {
+    const plano::compute::BlockMultigrid cycle(aggregation, aggregation.coarsen(K));
+    memory.markLoopStart();
+    for (auto _ : state) {
+      for (Eigen::Index j = 0; j < r.cols(); ++j) benchmark::DoNotOptimize(cycle.apply(r.col(j)).data());
+    }
+  } else {
+    try {
+      plano::vk::Context& context = static_cast<plano::compute::VulkanBackend*>(backend)->context();
+      plano::vk::LinearAlgebra algebra(context);
+      plano::vk::Multigrid multigrid(context, algebra, aggregation, K0, K0);
+      multigrid.setK1(K1);
+      plano::vk::DeviceCsrMatrix deviceK(context, K);
+      plano::vk::Array<double> inverses(context, static_cast<std::size_t>(K.rows()) * 4,
+                                        plano::vk::MemoryClass::Device, "block inverses");
+      plano::vk::Array<std::uint32_t> failure(context, 1, plano::vk::MemoryClass::Host, "failure");
+      const std::uint32_t none = ~0u;
+      failure.upload({&none, 1});
+      plano::vk::DeviceVectors input(context, static_cast<std::uint32_t>(r.rows()), 3, "r");
+      plano::vk::DeviceVectors output(context, input.n(), 3, "z");
+      input.upload(r);
+      plano::vk::Sequence setup(context);
+      setup.begin();
+      algebra.invertDiagonalBlocks(setup, deviceK, 4, inverses, failure);
+      multigrid.setRho(setup, rho, failure);
+      setup.end();
+      setup.run();
+      const auto binding = multigrid.bind(deviceK, inverses, input, output);
+      plano::vk::Sequence cycle(context);
+      cycle.begin();
+      multigrid.record(cycle, *binding, nullptr, 0, 0);
+      cycle.end();
+      cycle.run();  // JIT outside the timed loop
+      memory.markLoopStart();
+      double deviceSeconds = 0.0;
+      for (auto _ : state) {
+        cycle.run();
+        deviceSeconds += cycle.lastDeviceSeconds();
+      }
+      state.counters["device_ms"] = benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
+    } catch (const plano::Error& e) {  // e.g. larger than lavapipe's 2 GiB heap
+      state.SkipWithError(e.what());
+      return;
+    }
+  }
+  plano::bench::setFaceCounters(state, mesh);
+  state.counters["levels"] = aggregation.levelCount();
+  state.counters["rows"] = static_cast<double>(K.rows());
+  state.counters["nonzeros"] = static_cast<double>(K.nonZeros());
+}
+
 /// The same matrix as a ScaledConstraintMatrix (its pattern once, values per step).
 plano::projective::ScaledConstraintMatrix scaledCompatibilityMatrix(const plano::projective::ShapeSpace& space) {
   std::vector<plano::projective::ScaledConstraintMatrix::Term> terms;
@@ -293,6 +372,10 @@ BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, Solve
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_scales, BackendChoice::Vulkan, SolverReuse::KeptScales)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, filled, true)

@@ -65,7 +65,7 @@ DenseAndIterative eigenshapesBothWays(Index side, SpaceKind kind, Index count) {
 TEST(Eigenshapes, SpectraAgreesWithTheDenseSolver) {
   const DenseAndIterative r = eigenshapesBothWays(8, SpaceKind::Parallel, 6);
   EXPECT_FALSE(r.info.dense);
-  EXPECT_LE((r.dense.frequencies - r.iterative.frequencies).cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_LE((r.dense.frequencies - r.iterative.frequencies).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST(Eigenshapes, ShiftInvertLanczosFindsTheZeroFrequenciesAndTheDenseSolversShapes) {
@@ -78,7 +78,9 @@ TEST(Eigenshapes, ShiftInvertLanczosFindsTheZeroFrequenciesAndTheDenseSolversSha
   ASSERT_FALSE(r.info.dense);
   EXPECT_LE(r.info.iterations, 5);
   EXPECT_LE(b.frequencies.head(3).cwiseAbs().maxCoeff(), 1e-10);
-  EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-9);
+  // Rayleigh quotients of the Ritz vectors (4e-16 here); the Ritz values themselves were off
+  // by up to 1.3e-9 on some machines.
+  EXPECT_LE((a.frequencies - b.frequencies).cwiseAbs().maxCoeff(), 1e-12);
   // The same shapes: each of b's lies in the span of a's eigenshapes of its frequency (but
   // the highest frequency, whose eigenspace the count may cut: the square grid's symmetry
   // makes eigenvalues double).
