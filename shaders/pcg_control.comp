@@ -74,7 +74,8 @@ void main() {
     state[0] = 1.0;
   }
   // [0..2]: fused kernels (groupsColumn x m), [3..5]: reductions (m), [6..8]: direction,
-  // [9..11]: paired reductions (2m: r.z and r.r).
+  // [9..11]: paired reductions (2m: r.z and r.r), [12..14]: the product, whose workgroups
+  // take every column (groupsColumn x 1).
   arguments[0] = running ? pc.groupsColumn : 0;
   arguments[1] = pc.m;
   arguments[2] = 1;
@@ -87,4 +88,7 @@ void main() {
   arguments[9] = running ? 2 * pc.m : 0;
   arguments[10] = 1;
   arguments[11] = 1;
+  arguments[12] = running ? pc.groupsColumn : 0;
+  arguments[13] = 1;
+  arguments[14] = 1;
 }

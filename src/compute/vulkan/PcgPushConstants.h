@@ -11,7 +11,7 @@ struct PcgStepPush {
   std::uint32_t residualNorms = 0;  ///< 1: also r.r's partial sums (needs 2m columns of partials).
 };
 struct PcgSpmvDotPush {
-  std::uint32_t n;
+  std::uint32_t n, m;
 };
 struct PcgDirectionPush {
   std::uint32_t n, m, slotNew, slotOld;

@@ -90,8 +90,9 @@ bool isCpuDevice(const Context& context) { return context.info().type == VK_PHYS
 /// The single-workgroup kernel's size: on CPU devices every invocation pays for every
 /// barrier, so fewer; on GPUs more lanes sweep the rows.
 std::uint32_t singleWorkgroupSize(const Context& context) { return isCpuDevice(context) ? 64 : 256; }
-// pcg_control's indirect arguments (byte offsets of its four triples).
-constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24, kPairReduceArguments = 36;
+// pcg_control's indirect arguments (byte offsets of its five triples).
+constexpr std::size_t kFusedArguments = 0, kReduceArguments = 12, kDirectionArguments = 24, kPairReduceArguments = 36,
+                      kProductArguments = 48;
 
 std::uint32_t blockSize(int block, std::uint32_t n) {
   if (block < 1 || block > 4 || n % static_cast<std::uint32_t>(block) != 0) {
@@ -266,7 +267,7 @@ struct AdmmKernels::Workspace {
         measures(context, kMeasureSlots, k, std::max(n, m)),
         violationNorms(context, 1, k, std::max(m, 1u)),
         state(context, kStateSize, MemoryClass::Device, "PCG control state"),
-        arguments(context, 12, MemoryClass::Device, "PCG indirect arguments"),
+        arguments(context, 15, MemoryClass::Device, "PCG indirect arguments"),
         check(context) {}
   std::uint32_t k;
   bool singleWorkgroup = false;
@@ -814,7 +815,7 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
     // The iteration of vk::PcgSolver; r.z alternates between two slots.
     const std::uint32_t current = (j + parity) % 2 == 0 ? kRzEven : kRzOdd;
     const std::uint32_t next = (j + parity) % 2 == 0 ? kRzOdd : kRzEven;
-    s.dispatchIndirect(spmvDot_, *w.spmvDotSet, PcgSpmvDotPush{n_}, w.arguments, kFusedArguments);
+    s.dispatchIndirect(spmvDot_, *w.spmvDotSet, PcgSpmvDotPush{n_, k}, w.arguments, kProductArguments);
     s.barrier();
     s.dispatchIndirect(reduce_, *w.reduceSet, ReducePush{groups, k, kPq}, w.arguments, kReduceArguments);
     s.barrier();

@@ -10,8 +10,11 @@
 namespace plano::vk {
 namespace {
 
-struct TransferPush {  // mg_restrict, mg_prolong
+struct TransferPush {  // mg_residual_restrict, mg_prolong
   std::uint32_t fineRows, coarseRows, m, b;
+};
+struct ResidualPush {  // la_residual
+  std::uint32_t rows, cols, m;
 };
 struct CoarsestAssemblePush {  // mg_coarsest_assemble
   std::uint32_t rows, pad;
@@ -79,13 +82,13 @@ struct Multigrid::Level {
   std::unique_ptr<Array<double>> k0, k1;          ///< Levels 1 .. L-2: values on K's pattern.
   std::unique_ptr<Array<double>> inverses;        ///< Levels 1 .. L-2: block-Jacobi inverses.
   std::unique_ptr<DeviceVectors> r, z;            ///< Levels 1 ..: restricted residual, correction.
-  std::unique_ptr<DeviceVectors> t, u;            ///< Levels 0 .. L-2: residual and smoothing scratch.
+  std::unique_ptr<DeviceVectors> t;               ///< Levels 0 .. L-2: the residual on the way up.
   std::unique_ptr<Array<std::int32_t>> aggregates, childOffsets, children;  ///< Levels 0 .. L-2.
 };
 
 /// Descriptor sets of one level's steps.
 struct LevelSets {
-  std::unique_ptr<DescriptorSet> smoothDown, product, residual, restrictTo, prolongFrom, smoothUp, update;
+  std::unique_ptr<DescriptorSet> smoothDown, restrictResidual, prolongFrom, residual, smoothUp;
 };
 
 struct Multigrid::Binding::Sets {
@@ -105,8 +108,9 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       aggregation_(aggregation),
       spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
       scale_(context, "la_scale_rows", 3, sizeof(ScalePush)),
-      axpby_(context, "la_axpby", 2, sizeof(AxpbyPush)),
-      restrict_(context, "mg_restrict", 4, sizeof(TransferPush)),
+      residual_(context, "la_residual", 6, sizeof(ResidualPush)),
+      scaleAdd_(context, "la_scale_rows_add", 3, sizeof(ScalePush)),
+      restrictResidual_(context, "mg_residual_restrict", 8, sizeof(TransferPush)),
       prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
       coarsestAssemble_(context, "mg_coarsest_assemble", 5, sizeof(CoarsestAssemblePush)),
@@ -239,10 +243,7 @@ std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, co
         level.r = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid residual");
         level.z = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid correction");
       }
-      if (l + 1 < L) {
-        level.t = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid residual scratch");
-        level.u = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid smoothing scratch");
-      }
+      if (l + 1 < L) level.t = std::make_unique<DeviceVectors>(context_, level.rows, columns_, "multigrid residual");
     }
   }
   std::unique_ptr<Binding> binding(new Binding());
@@ -255,18 +256,18 @@ std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, co
     const Array<double>& zl = l == 0 ? z.data() : level.z->data();
     LevelSets sets;
     sets.smoothDown = std::make_unique<DescriptorSet>(context_, scale_, std::initializer_list<BufferRange>{inverses, rl, zl});
-    sets.product = std::make_unique<DescriptorSet>(
-        context_, spmv_,
-        std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, level.t->data()});
-    sets.residual = std::make_unique<DescriptorSet>(context_, axpby_, std::initializer_list<BufferRange>{rl, level.t->data()});
-    sets.restrictTo = std::make_unique<DescriptorSet>(
-        context_, restrict_,
-        std::initializer_list<BufferRange>{*level.childOffsets, *level.children, level.t->data(), coarse.r->data()});
+    sets.restrictResidual = std::make_unique<DescriptorSet>(
+        context_, restrictResidual_,
+        std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
+                                           *level.childOffsets, *level.children, coarse.r->data()});
     sets.prolongFrom = std::make_unique<DescriptorSet>(
         context_, prolong_, std::initializer_list<BufferRange>{*level.aggregates, coarse.z->data(), zl});
-    sets.smoothUp = std::make_unique<DescriptorSet>(
-        context_, scale_, std::initializer_list<BufferRange>{inverses, level.t->data(), level.u->data()});
-    sets.update = std::make_unique<DescriptorSet>(context_, axpby_, std::initializer_list<BufferRange>{level.u->data(), zl});
+    sets.residual = std::make_unique<DescriptorSet>(
+        context_, residual_,
+        std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
+                                           level.t->data()});
+    sets.smoothUp = std::make_unique<DescriptorSet>(context_, scaleAdd_,
+                                                    std::initializer_list<BufferRange>{inverses, level.t->data(), zl});
     binding->sets_->levels.push_back(std::move(sets));
   }
   const Level& last = *levels_.back();
@@ -281,7 +282,8 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
                        std::size_t elementsTriple) {
   const std::uint32_t k = columns_;
   if (k == 0) throwUsage("multigrid: record before bind");
-  // Products: one workgroup row per column; the rest: over all entries.
+  // The coarsest product: one workgroup row per column; the rest over all entries or rows
+  // (the fused products take every column of a row, reading K's row once).
   auto run = [&](const Pipeline& pipeline, const DescriptorSet& set, const auto& push, bool rows, std::uint32_t count) {
     if (arguments) {
       sequence.dispatchIndirect(pipeline, set, push, *arguments, rows ? rowsTriple : elementsTriple);
@@ -294,10 +296,8 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
   for (int l = 0; l + 1 < L; ++l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, nc = levels_[l + 1]->rows;
-    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, false, n * k);         // z = S r
-    run(spmv_, *sets.product, SpmvPush{n, n}, true, n);                           // t = K z
-    run(axpby_, *sets.residual, AxpbyPush{n * k, 0, 1.0, -1.0}, false, n * k);     // t = r - t
-    run(restrict_, *sets.restrictTo, TransferPush{n, nc, k, block_}, false, nc * k);  // r_c = Z^T t
+    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, false, n * k);                         // z = S r
+    run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, false, nc);  // r_c = Z^T (r - K z)
   }
   const std::uint32_t nc = levels_.back()->rows;
   run(spmv_, *binding.sets_->coarsest, SpmvPush{nc, nc}, true, nc);  // z_c = K_c^-1 r_c
@@ -305,10 +305,8 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, coarse = levels_[l + 1]->rows;
     run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, false, n * k);  // z += Z z_c
-    run(spmv_, *sets.product, SpmvPush{n, n}, true, n);                                // t = K z
-    run(axpby_, *sets.residual, AxpbyPush{n * k, 0, 1.0, -1.0}, false, n * k);          // t = r - t
-    run(scale_, *sets.smoothUp, ScalePush{n, k, block_}, false, n * k);                 // u = S t
-    run(axpby_, *sets.update, AxpbyPush{n * k, 0, 1.0, 1.0}, false, n * k);             // z = u + z
+    run(residual_, *sets.residual, ResidualPush{n, n, k}, false, n);                   // t = r - K z
+    run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, false, n * k);             // z += S t
   }
 }
 

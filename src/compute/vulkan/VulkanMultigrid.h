@@ -15,8 +15,11 @@
 // host inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
 // deformation, up to 8 MiB), after downloading the coarsest K1 at each new C.
 //
-// One cycle: on each level, z = S r (block-Jacobi), t = r - K z, restrict t; the coarsest
-// z = K^-1 r; back up, z += Z z_coarse, t = r - K z, z += S t. Every dispatch is sized by
+// One cycle: on each level, z = S r (block-Jacobi), then r_coarse = Z^T (r - K z) in one
+// kernel; the coarsest z = K^-1 r; back up, z += Z z_coarse, t = r - K z, z += S t: five
+// dispatches per level but the coarsest (nine before the fused kernels: each product, each
+// subtraction and each smoothing update its own, with a pass over memory between them).
+// Every dispatch is sized by
 // one of two caller-given indirect triples, so that inside a recorded PCG the cycles of a
 // converged solve cost empty dispatches: a rows triple (x workgroups, one workgroup row per
 // column) for the products and an elements triple (x workgroups, 1) for the rest; all
@@ -96,7 +99,8 @@ class Multigrid {
   std::unique_ptr<DeviceCsrMatrix> coarsestK0_;            ///< The coarsest level's K0, on its pattern.
   std::unique_ptr<Array<double>> coarsestK1Values_;        ///< On the coarsest level's pattern.
   bool k1Set_ = false;
-  Pipeline spmv_, scale_, axpby_, restrict_, prolong_, assemble_, coarsestAssemble_, coarsestInvert_;
+  Pipeline spmv_, scale_, residual_, scaleAdd_, restrictResidual_, prolong_, assemble_, coarsestAssemble_,
+      coarsestInvert_;
   std::uint32_t inversionStepsPerDispatch_;
   Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
 };

@@ -136,7 +136,7 @@ void PcgSolver::prepare(std::uint32_t m) {
     w.block.dispatch(spmvDot_,
                      {matrix_.rowOffsets(), matrix_.columns(), matrix_.values(), w.p.data(), w.q.data(),
                       w.scalars.partial()},
-                     PcgSpmvDotPush{n_}, w.scalars.groups(), m);
+                     PcgSpmvDotPush{n_, m}, w.scalars.groups());
     w.block.barrier();
     la.reduce(w.block, w.scalars, kPq);
     w.block.dispatch(step_,
