@@ -245,7 +245,7 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
       const auto binding = multigrid.bind(deviceK, inverses, input, output);
       plano::vk::Sequence cycle(context);
       cycle.begin();
-      multigrid.record(cycle, *binding, nullptr, 0, 0);
+      multigrid.record(cycle, *binding, nullptr, 0);
       cycle.end();
       cycle.run();  // JIT outside the timed loop
       memory.markLoopStart();

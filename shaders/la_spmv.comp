@@ -1,6 +1,7 @@
 #version 450
 // Y = A X for a CSR matrix A (#rows x #cols) and m right-hand sides stored column after
-// column (X: cols x m, Y: rows x m). Workgroup row y of the dispatch is the column.
+// column (X: cols x m, Y: rows x m). Each invocation takes a row for every column, reading
+// A's row once per four columns (csr_rows.glsl). Dispatch: one row of workgroups.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
@@ -12,18 +13,20 @@ layout(std430, binding = 2) readonly buffer Values { double values[]; };
 layout(std430, binding = 3) readonly buffer X { double x[]; };
 layout(std430, binding = 4) writeonly buffer Y { double y[]; };
 
+#include "csr_rows.glsl"
+
 layout(push_constant) uniform Push {
   uint rows;
   uint cols;
+  uint m;
 } pc;
 
 void main() {
-  const uint column = gl_WorkGroupID.y;
-  const uint xBase = column * pc.cols;
   GRID_STRIDE_LOOP(r, pc.rows) {
-    double sum = 0.0;
-    const int end = rowOffsets[r + 1];
-    for (int e = rowOffsets[r]; e < end; ++e) sum += values[e] * x[xBase + uint(columns[e])];
-    y[column * pc.rows + r] = sum;
+    for (uint first = 0; first < pc.m; first += 4) {
+      const uint width = min(4u, pc.m - first);
+      const dvec4 product = csrRowTimesColumns(r, first, width, pc.cols);
+      for (uint j = 0; j < width; ++j) y[(first + j) * pc.rows + r] = product[j];
+    }
   }
 }

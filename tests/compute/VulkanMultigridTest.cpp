@@ -60,7 +60,7 @@ Eigen::MatrixXd deviceCycle(vk::Context& context, const compute::BlockAggregatio
   algebra.invertDiagonalBlocks(s, deviceK, 4, inverses, failure);
   multigrid.setRho(s, rho, failure);
   const auto binding = multigrid.bind(deviceK, inverses, input, output);
-  multigrid.record(s, *binding, nullptr, 0, 0);
+  multigrid.record(s, *binding, nullptr, 0);
   s.end();
   s.run();
   std::uint32_t failed = 0;

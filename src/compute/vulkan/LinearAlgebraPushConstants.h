@@ -6,8 +6,8 @@
 
 namespace plano::vk {
 
-struct SpmvPush {  // la_spmv
-  std::uint32_t rows, cols;
+struct SpmvPush {  // la_spmv, la_residual
+  std::uint32_t rows, cols, m;
 };
 struct DotPush {  // la_dot
   std::uint32_t n;

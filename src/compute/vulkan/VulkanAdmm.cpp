@@ -767,7 +767,7 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   la.copy(s, w.rhs, w.r);
   la.axpby(s, -1.0, w.Kp, 1.0, w.r);
   if (multigrid_) {
-    multigrid_->record(s, *w.cycleResidual, nullptr, 0, 0);
+    multigrid_->record(s, *w.cycleResidual, nullptr, 0);
   } else {
     la.applyBlockDiagonal(s, inverseBlocks_, block_, w.r, w.preconditioned);
   }
@@ -776,7 +776,7 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   la.dot(s, w.r, w.r, w.pcg, kRrEven);
   if (target == SolveTarget::WarmStart) la.dot(s, w.r, w.preconditioned, w.pcg, kBz);
   if (multigrid_) {  // Kp as scratch for M^-1 b
-    multigrid_->record(s, *w.cycleRhs, nullptr, 0, 0);
+    multigrid_->record(s, *w.cycleRhs, nullptr, 0);
   } else {
     la.applyBlockDiagonal(s, inverseBlocks_, block_, w.rhs, w.Kp);
   }
@@ -825,7 +825,7 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
     if (multigrid_) {
       // The step's z = blockdiag^-1 r and its r.z are replaced: z = M r, then r.z's partial
       // sums (r.r's, from the step, stay), all sized by the control's triples.
-      multigrid_->record(s, *w.cycleResidual, &w.arguments, kFusedArguments, kDirectionArguments);
+      multigrid_->record(s, *w.cycleResidual, &w.arguments, kDirectionArguments);
       s.dispatchIndirect(dot_, *w.rzSet, DotPush{n_}, w.arguments, kFusedArguments);
       s.barrier();
     }

@@ -151,7 +151,7 @@ void LinearAlgebra::spmv(Sequence& sequence, const DeviceCsrMatrix& A, const Dev
                std::to_string(Y.m()));
   }
   sequence.dispatch(spmv_, {A.rowOffsets(), A.columns(), A.values(), X.data(), Y.data()},
-                    SpmvPush{A.rows(), A.cols()}, groupsFor(context_, A.rows()), X.m());
+                    SpmvPush{A.rows(), A.cols(), X.m()}, groupsFor(context_, A.rows()));
   sequence.barrier();
 }
 

@@ -13,9 +13,6 @@ namespace {
 struct TransferPush {  // mg_residual_restrict, mg_prolong
   std::uint32_t fineRows, coarseRows, m, b;
 };
-struct ResidualPush {  // la_residual
-  std::uint32_t rows, cols, m;
-};
 struct CoarsestAssemblePush {  // mg_coarsest_assemble
   std::uint32_t rows, pad;
   double rho;
@@ -108,7 +105,7 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       aggregation_(aggregation),
       spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
       scale_(context, "la_scale_rows", 3, sizeof(ScalePush)),
-      residual_(context, "la_residual", 6, sizeof(ResidualPush)),
+      residual_(context, "la_residual", 6, sizeof(SpmvPush)),
       scaleAdd_(context, "la_scale_rows_add", 3, sizeof(ScalePush)),
       restrictResidual_(context, "mg_residual_restrict", 8, sizeof(TransferPush)),
       prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
@@ -278,17 +275,16 @@ std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, co
   return binding;
 }
 
-void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t rowsTriple,
-                       std::size_t elementsTriple) {
+void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t triple) {
   const std::uint32_t k = columns_;
   if (k == 0) throwUsage("multigrid: record before bind");
-  // The coarsest product: one workgroup row per column; the rest over all entries or rows
-  // (the fused products take every column of a row, reading K's row once).
-  auto run = [&](const Pipeline& pipeline, const DescriptorSet& set, const auto& push, bool rows, std::uint32_t count) {
+  // Every kernel loops grid-stride over its entries, or its rows for the products (which take
+  // every column of a row, reading K's row once), in one row of workgroups.
+  auto run = [&](const Pipeline& pipeline, const DescriptorSet& set, const auto& push, std::uint32_t count) {
     if (arguments) {
-      sequence.dispatchIndirect(pipeline, set, push, *arguments, rows ? rowsTriple : elementsTriple);
+      sequence.dispatchIndirect(pipeline, set, push, *arguments, triple);
     } else {
-      sequence.dispatch(pipeline, set, push, groupsFor(context_, count), rows ? k : 1);
+      sequence.dispatch(pipeline, set, push, groupsFor(context_, count));
     }
     sequence.barrier();
   };
@@ -296,17 +292,17 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
   for (int l = 0; l + 1 < L; ++l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, nc = levels_[l + 1]->rows;
-    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, false, n * k);                         // z = S r
-    run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, false, nc);  // r_c = Z^T (r - K z)
+    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, n * k);                         // z = S r
+    run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, nc);  // r_c = Z^T (r - K z)
   }
   const std::uint32_t nc = levels_.back()->rows;
-  run(spmv_, *binding.sets_->coarsest, SpmvPush{nc, nc}, true, nc);  // z_c = K_c^-1 r_c
+  run(spmv_, *binding.sets_->coarsest, SpmvPush{nc, nc, k}, nc);  // z_c = K_c^-1 r_c
   for (int l = L - 2; l >= 0; --l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, coarse = levels_[l + 1]->rows;
-    run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, false, n * k);  // z += Z z_c
-    run(residual_, *sets.residual, ResidualPush{n, n, k}, false, n);                   // t = r - K z
-    run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, false, n * k);             // z += S t
+    run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, n * k);  // z += Z z_c
+    run(residual_, *sets.residual, SpmvPush{n, n, k}, n);                              // t = r - K z
+    run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, n * k);             // z += S t
   }
 }
 

@@ -20,10 +20,9 @@
 // dispatches per level but the coarsest (nine before the fused kernels: each product, each
 // subtraction and each smoothing update its own, with a pass over memory between them).
 // Every dispatch is sized by
-// one of two caller-given indirect triples, so that inside a recorded PCG the cycles of a
-// converged solve cost empty dispatches: a rows triple (x workgroups, one workgroup row per
-// column) for the products and an elements triple (x workgroups, 1) for the rest; all
-// kernels loop grid-stride, so any x count is correct.
+// one caller-given indirect triple (x workgroups, 1, 1), so that inside a recorded PCG the
+// cycles of a converged solve cost empty dispatches; all kernels loop grid-stride, so any
+// x count is correct.
 #include <memory>
 #include <vector>
 
@@ -79,9 +78,8 @@ class Multigrid {
   std::unique_ptr<Binding> bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks, const DeviceVectors& r,
                                 DeviceVectors& z);
   /// Record one cycle z = M r of `binding`, each dispatch indirect from `arguments` (the
-  /// rows and elements triples' byte offsets), or direct when `arguments` is null.
-  void record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t rowsTriple,
-              std::size_t elementsTriple);
+  /// triple at byte offset `triple`), or direct when `arguments` is null.
+  void record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t triple);
 
   int levelCount() const { return static_cast<int>(levels_.size()); }
 
