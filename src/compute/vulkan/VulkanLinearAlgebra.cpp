@@ -82,9 +82,11 @@ DeviceScalars::DeviceScalars(Context& context, std::uint32_t slots, std::uint32_
                              std::uint32_t partialColumns)
     : slots_(slots),
       m_(m),
-      // Each thread of the first pass sums at least four entries; 1024 groups keep the
-      // second pass (one workgroup per column) short.
-      groups_(std::clamp<std::uint32_t>((maxN + 4 * kWorkGroupSize - 1) / (4 * kWorkGroupSize), 1, 1024)),
+      // Each thread of the first pass sums at least four entries. At most 4096 groups keep
+      // the second pass (one workgroup per column) short, and let the fused PCG product, whose
+      // invocations take every column of a row, run as many invocations (262 144) as it
+      // did with a row of 1024 groups per column for three columns.
+      groups_(std::clamp<std::uint32_t>((maxN + 4 * kWorkGroupSize - 1) / (4 * kWorkGroupSize), 1, 4096)),
       values_(context, static_cast<std::size_t>(slots) * m, MemoryClass::Device, "device scalars"),
       partial_(context, static_cast<std::size_t>(groups_) * std::max(m, partialColumns), MemoryClass::Device,
                "partial sums") {
