@@ -292,7 +292,7 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
   for (int l = 0; l + 1 < L; ++l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, nc = levels_[l + 1]->rows;
-    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, n * k);                         // z = S r
+    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, n * k);                       // z = S r
     run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, nc);  // r_c = Z^T (r - K z)
   }
   const std::uint32_t nc = levels_.back()->rows;
@@ -301,8 +301,8 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, coarse = levels_[l + 1]->rows;
     run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, n * k);  // z += Z z_c
-    run(residual_, *sets.residual, SpmvPush{n, n, k}, n);                              // t = r - K z
-    run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, n * k);             // z += S t
+    run(residual_, *sets.residual, SpmvPush{n, n, k}, n);                         // t = r - K z
+    run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, n * k);               // z += S t
   }
 }
 
