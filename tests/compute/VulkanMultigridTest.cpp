@@ -75,9 +75,11 @@ TEST_F(VulkanMultigrid, CycleEqualsTheHostReferenceOnAGlobalStepMatrix) {
   const auto [K0, K1] = splitK(globalStepMatrices(24));  // 576 faces: three levels
   const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), {4});
   ASSERT_GE(aggregation.levelCount(), 3);
-  const Eigen::MatrixXd r = randomColumns(K0.rows(), 3, 7);
-  for (double rho : {1e2, 1e5}) {
-    SCOPED_TRACE(rho);
+  // Three columns (a global step's) at two penalties, and five: the fused products take
+  // four columns an invocation, then the fifth.
+  for (const auto& [rho, columns] : {std::pair{1e2, 3}, std::pair{1e5, 3}, std::pair{1e3, 5}}) {
+    SCOPED_TRACE(testing::Message() << "rho " << rho << ", " << columns << " columns");
+    const Eigen::MatrixXd r = randomColumns(K0.rows(), columns, 7);
     int levels = 0;
     const Eigen::MatrixXd device = deviceCycle(context(), aggregation, K0, K1, rho, r, &levels);
     EXPECT_EQ(levels, aggregation.levelCount());
