@@ -796,7 +796,8 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   if (!continuation) recordPcgStart(s, target);
 
   const std::uint32_t groups = w.pcg.groups();
-  const std::uint32_t directionGroups = groupsFor(context_, nk);
+  // The direction update's and the V-cycle's sweeps (vk::Multigrid::record).
+  const std::uint32_t directionGroups = sweepGroupsFor(context_, nk);
   const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
   // The polish's solves (tol ||r0||) stop at the rounding floor of ||b|| too.
   const std::uint32_t floorSlot = target == SolveTarget::RightHandSide ? kNoFloor : kRhsBz;

@@ -205,7 +205,7 @@ void LinearAlgebra::maxAbs(Sequence& sequence, std::uint32_t terms, const Device
 void LinearAlgebra::axpby(Sequence& sequence, double a, const DeviceVectors& X, double b, DeviceVectors& Y) {
   requireSameShape(X, Y, "axpby");
   const std::uint32_t count = X.n() * X.m();
-  sequence.dispatch(axpby_, {X.data(), Y.data()}, AxpbyPush{count, 0, a, b}, groupsFor(context_, count));
+  sequence.dispatch(axpby_, {X.data(), Y.data()}, AxpbyPush{count, 0, a, b}, sweepGroupsFor(context_, count));
   sequence.barrier();
 }
 
@@ -221,7 +221,7 @@ void LinearAlgebra::applyBlockDiagonal(Sequence& sequence, const Array<double>& 
                std::to_string(X.n()) + " rows in blocks of " + std::to_string(b));
   }
   sequence.dispatch(scaleRows_, {blocks, X.data(), Y.data()}, ScalePush{X.n(), X.m(), b},
-                    groupsFor(context_, static_cast<std::size_t>(X.n()) * X.m()));
+                    sweepGroupsFor(context_, static_cast<std::size_t>(X.n()) * X.m()));
   sequence.barrier();
 }
 
@@ -245,7 +245,7 @@ void LinearAlgebra::clamp(Sequence& sequence, const DeviceVectors& X, const Devi
   requireSameShape(X, U, "clamp");
   requireSameShape(X, Y, "clamp");
   const std::uint32_t count = X.n() * X.m();
-  sequence.dispatch(clamp_, {X.data(), L.data(), U.data(), Y.data()}, CountPush{count}, groupsFor(context_, count));
+  sequence.dispatch(clamp_, {X.data(), L.data(), U.data(), Y.data()}, CountPush{count}, sweepGroupsFor(context_, count));
   sequence.barrier();
 }
 

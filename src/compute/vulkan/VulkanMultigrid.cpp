@@ -284,7 +284,7 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
     if (arguments) {
       sequence.dispatchIndirect(pipeline, set, push, *arguments, triple);
     } else {
-      sequence.dispatch(pipeline, set, push, groupsFor(context_, count));
+      sequence.dispatch(pipeline, set, push, sweepGroupsFor(context_, count));
     }
     sequence.barrier();
   };

@@ -146,7 +146,7 @@ void PcgSolver::prepare(std::uint32_t m) {
     w.block.barrier();
     la.reduce(w.block, w.scalars, next);
     w.block.dispatch(direction_, {w.z.data(), w.p.data(), w.scalars.values()},
-                     PcgDirectionPush{n_, m, next, current}, groupsFor(context_, count));
+                     PcgDirectionPush{n_, m, next, current}, sweepGroupsFor(context_, count));
     w.block.barrier();
   }
   la.dot(w.block, w.r, w.r, w.scalars, kRr);

@@ -123,4 +123,9 @@ std::uint32_t groupsFor(const Context& context, std::size_t items, std::uint32_t
   return static_cast<std::uint32_t>(std::clamp<std::size_t>(groups, 1, context.info().maxWorkGroupCount[0]));
 }
 
+std::uint32_t sweepGroupsFor(const Context& context, std::size_t items) {
+  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU) return groupsFor(context, items);
+  return groupsFor(context, items, kWorkGroupSize * kCpuSweepItemsPerInvocation);
+}
+
 }  // namespace plano::vk

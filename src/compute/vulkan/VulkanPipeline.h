@@ -74,4 +74,15 @@ inline constexpr std::uint32_t kWorkGroupSize = 64;
 /// them, capped at the device's maxComputeWorkGroupCount[0] (the kernels loop over the rest).
 std::uint32_t groupsFor(const Context& context, std::size_t items, std::uint32_t groupSize = kWorkGroupSize);
 
+/// Items each invocation of a sweep takes on a CPU device (sweepGroupsFor).
+inline constexpr std::uint32_t kCpuSweepItemsPerInvocation = 16;
+
+/// Workgroups for a grid-stride sweep over `items` light items (an entry update, a row of a
+/// few dozen entries: nothing near llvmpipe's 65 535 loop back-edges per invocation), whose
+/// result does not depend on the workgroup count. On GPUs groupsFor; on CPU devices
+/// (lavapipe), where a workgroup costs ~1.4 us of scheduling however little it does, each
+/// invocation takes kCpuSweepItemsPerInvocation items: with one item each, a ~1k-face global
+/// step spent a third of its time on workgroups (104 s against 69 s with three per sweep).
+std::uint32_t sweepGroupsFor(const Context& context, std::size_t items);
+
 }  // namespace plano::vk
