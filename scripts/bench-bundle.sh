@@ -24,7 +24,13 @@ mkdir -p "$out/bin" "$out/lib"
 cp "$BUILD_DIR/bench/plano_bench" "$BUILD_DIR/plano" "$out/bin/"
 # Every library the two programs load, but the C library's own (libc, libm, the dynamic
 # loader), which must be the target machine's.
-ldd "$out/bin/plano_bench" "$out/bin/plano" | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
+libraries=$(ldd "$out/bin/plano_bench" "$out/bin/plano")
+if grep -q "not found" <<<"$libraries"; then
+  echo "bench-bundle: libraries the programs need are missing here:" >&2
+  grep "not found" <<<"$libraries" >&2
+  exit 1
+fi
+awk '$2 == "=>" && $3 ~ /^\// {print $3}' <<<"$libraries" | sort -u |
   grep -v -E '/(libc|libm|libdl|libpthread|librt|ld-linux[^/]*)\.so' | while read -r library; do
   cp -L "$library" "$out/lib/"
 done
