@@ -9,6 +9,7 @@
 #include "compute/vulkan/VulkanBuffer.h"
 #include "compute/VulkanFixture.h"
 #include "compute/vulkan/VulkanContext.h"
+#include "compute/vulkan/VulkanPipeline.h"
 #include "core/Error.h"
 
 namespace plano::test {
@@ -20,6 +21,17 @@ TEST(VulkanContext, ReportsDoublePrecisionAndLimits) {
   EXPECT_GT(context.info().maxStorageBufferRange, 0u);
   EXPECT_GE(context.info().maxWorkGroupCount[0], 65535u);
   EXPECT_FALSE(context.info().name.empty());
+}
+
+TEST(VulkanContext, SweepsGiveEachInvocationSixteenItemsOnCpuDevicesAndOneOnGpus) {
+  vk::Context context(validatedSettings());
+  const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const std::uint32_t perGroup = vk::kWorkGroupSize * (cpu ? vk::kCpuSweepItemsPerInvocation : 1);
+  EXPECT_EQ(vk::sweepGroupsFor(context, 10 * perGroup), 10u);
+  EXPECT_EQ(vk::sweepGroupsFor(context, 10 * perGroup + 1), 11u);
+  EXPECT_EQ(vk::sweepGroupsFor(context, 1), 1u);
+  EXPECT_EQ(vk::sweepGroupsFor(context, 0), 1u);  // Vulkan forbids empty dispatches
+  EXPECT_EQ(vk::groupsFor(context, 10 * vk::kWorkGroupSize), 10u);  // other kernels: one item each
 }
 
 TEST(VulkanContext, ValidationMessengerRecordsInvalidUsage) {
