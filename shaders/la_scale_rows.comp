@@ -17,14 +17,10 @@ layout(push_constant) uniform Push {
   uint b;
 } pc;
 
+#include "block_rows.glsl"
+
 void main() {
   GRID_STRIDE_LOOP(i, pc.n * pc.m) {
-    const uint row = i % pc.n;
-    const uint first = row - row % pc.b;  // first row of the block, in this column
-    const uint base = i - (row - first);
-    const uint entries = (row / pc.b) * pc.b * pc.b + (row - first) * pc.b;
-    double sum = 0.0;
-    for (uint t = 0; t < pc.b; ++t) sum += blocks[entries + t] * x[base + t];
-    y[i] = sum;
+    y[i] = blockRowTimes(i);
   }
 }
