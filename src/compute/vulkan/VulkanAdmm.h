@@ -5,6 +5,10 @@
 // one recorded command buffer runs the checkInterval iterations: only the check's
 // per-column inf-norms (a few dozen doubles) come back.
 //
+// Sources: VulkanAdmm.cpp (matrices, K's assembly, starts, checks), VulkanAdmmRecording.cpp
+// (the recorded iterations and their inner PCG), VulkanAdmmPolish.cpp (the polish's
+// refinements); VulkanAdmmWorkspace.h holds what they share.
+//
 // K = P + sigma I + C^T diag(rho) C: rho takes two values (rho, rho * equalityRhoScale on
 // equality rows), so K = K0 + rho K1 with K0 = P + sigma I and K1 = C^T D C (D = 1 or
 // equalityRhoScale), both stored on the union sparsity pattern; a rho update is one

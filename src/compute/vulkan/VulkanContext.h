@@ -165,4 +165,17 @@ T vkStruct(VkStructureType type) {
 /// Name of a VkResult, e.g. "VK_ERROR_DEVICE_LOST".
 const char* resultName(VkResult result);
 
+/// Whether the device runs on the host's CPU (lavapipe), where every workgroup and every
+/// barrier costs scheduling however little it does.
+inline bool isCpuDevice(const Context& context) { return context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+
+/// Lanes of a kernel that runs in a single workgroup, sweeping rows between barriers: on CPU
+/// devices every lane pays for every barrier, so fewer; on GPUs more lanes share the rows.
+inline std::uint32_t singleWorkgroupLanes(const Context& context) { return isCpuDevice(context) ? 64 : 256; }
+
+/// llvmpipe ends all loops of an invocation after 65535 back-edges in total: kernels whose
+/// loops could run longer split their work over dispatches on CPU devices, each estimated
+/// below this (half the limit).
+constexpr std::uint64_t kCpuLoopBackEdges = 32768;
+
 }  // namespace plano::vk

@@ -21,18 +21,13 @@ struct CoarsestInvertPush {  // mg_coarsest_invert
   std::uint32_t rows, begin, end, failureCode;
 };
 
-/// The coarsest inversion's workgroup: on CPU devices every lane pays for every barrier.
-std::uint32_t inversionLanes(const Context& context) {
-  return context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 : 256;
-}
-
-/// Elimination steps per dispatch of an inversion of `rows` rows: llvmpipe ends all loops
-/// of an invocation after 65535 back-edges in total (a step costs each lane about
-/// rows^2 / lanes of them), so CPU devices split it, keeping half that; GPUs run it whole.
+/// Elimination steps per dispatch of an inversion of `rows` rows: CPU devices split it (a
+/// step costs each lane about rows^2 / lanes loop back-edges; kCpuLoopBackEdges); GPUs run
+/// it whole.
 std::uint32_t inversionSteps(const Context& context, std::uint32_t rows, std::uint32_t lanes) {
-  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU) return std::max<std::uint32_t>(rows, 1);
+  if (!isCpuDevice(context)) return std::max<std::uint32_t>(rows, 1);
   const std::uint64_t perStep = (std::uint64_t{rows} * rows + 2 * rows) / lanes + 4;
-  return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(32768 / perStep, 1, std::max<std::uint32_t>(rows, 1)));
+  return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(kCpuLoopBackEdges / perStep, 1, std::max<std::uint32_t>(rows, 1)));
 }
 
 /// A's pattern with every stored value 1 (no cancellation when coarsened).
@@ -111,7 +106,7 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
       coarsestAssemble_(context, "mg_coarsest_assemble", 5, sizeof(CoarsestAssemblePush)),
-      coarsestInvert_(context, "mg_coarsest_invert", 2, sizeof(CoarsestInvertPush), inversionLanes(context)),
+      coarsestInvert_(context, "mg_coarsest_invert", 2, sizeof(CoarsestInvertPush), singleWorkgroupLanes(context)),
       inversionStepsPerDispatch_(1),
       noRows_(context, 1, MemoryClass::Device, "multigrid unused rows") {
   const int L = aggregation_.levelCount();
@@ -156,7 +151,7 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       full.makeCompressed();
       level->K = std::make_unique<DeviceCsrMatrix>(context, full);
       coarsestK0_ = std::make_unique<DeviceCsrMatrix>(context, onPattern(k0Levels[l], patternLevels[l]));
-      inversionStepsPerDispatch_ = inversionSteps(context, level->rows, inversionLanes(context));
+      inversionStepsPerDispatch_ = inversionSteps(context, level->rows, singleWorkgroupLanes(context));
     }
     patterns_.push_back(patternLevels[l]);
     levels_.push_back(std::move(level));

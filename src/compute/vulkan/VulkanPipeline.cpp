@@ -124,7 +124,7 @@ std::uint32_t groupsFor(const Context& context, std::size_t items, std::uint32_t
 }
 
 std::uint32_t sweepGroupsFor(const Context& context, std::size_t items) {
-  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU) return groupsFor(context, items);
+  if (!isCpuDevice(context)) return groupsFor(context, items);
   return groupsFor(context, items, kWorkGroupSize * kCpuSweepItemsPerInvocation);
 }
 

@@ -1,0 +1,247 @@
+// The device ADMM's polish (AdmmKernels, VulkanAdmm.h): refinements of an active set by the
+// method of multipliers on the device, the active sides, and the bound violation.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "compute/vulkan/VulkanAdmm.h"
+#include "compute/vulkan/VulkanAdmmWorkspace.h"
+#include "core/Cancellation.h"
+#include "core/Error.h"
+
+namespace plano::vk {
+
+using namespace admm;
+
+void AdmmKernels::recordPolish() {
+  Workspace& w = *workspace_;
+  LinearAlgebra& la = algebra_;
+  Workspace::Polish& p = *w.polish;
+  const int cap = withinSolverLimit(kPolishInnerIterations);
+  p.save.begin();
+  la.copy(p.save, w.x, p.x0);
+  la.copy(p.save, w.y, p.y0);
+  la.copy(p.save, w.z, p.z0);
+  la.copy(p.save, w.x, p.xKept);
+  la.copy(p.save, w.y, p.yKept);
+  p.save.end();
+  // rowScales_ holds the active flags (assembleK1), rhoRows_ = rho times them (assembleK).
+  p.begin.begin();
+  la.copy(p.begin, p.x0, w.x);
+  la.scaleRows(p.begin, rowScales_, p.y0, w.y);
+  p.begin.end();
+  // With z = b the ADMM's right-hand side is the refinement's:
+  //   sigma x - q + C^T (rho diag(active) b - lambda).
+  p.solve.begin();
+  recordRightHandSide(p.solve);
+  la.copy(p.solve, w.x, w.xTilde);
+  recordInnerSolve(p.solve, cap, SolveTarget::WarmStart);
+  p.solve.end();
+  // A solve that needs more continues where it stopped, not restarted: a PCG restarted
+  // every few dozen iterations converges far slower on the stiff K_A.
+  p.resume.begin();
+  recordInnerSolve(p.resume, kPolishResumeIterations, SolveTarget::Continuation, cap % 2 == 1);
+  p.resume.end();
+  // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
+  // lambda reaches it).
+  p.update.begin();
+  la.copy(p.update, w.xTilde, w.x);
+  la.spmv(p.update, devC_, w.x, w.Cx);
+  la.axpby(p.update, -1.0, w.z, 1.0, w.Cx);
+  la.scaleRows(p.update, rowScales_, w.Cx, w.zTilde);
+  la.scaleRows(p.update, rhoRows_, w.Cx, w.dy);
+  la.axpby(p.update, 1.0, w.dy, 1.0, w.y);
+  la.maxAbs(p.update, w.zTilde, w.measures, kPrimal);
+  p.update.end();
+}
+
+bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x,
+                                  Eigen::MatrixXd& y, compute::ActiveSetRefinementInfo& info) {
+  // No iterate (k = 0), or no rows to hold (m = 0: the host's unconstrained solve; the
+  // device would copy empty vectors, which Vulkan forbids).
+  if (!workspace_ || m_ == 0) return false;
+  Workspace& w = *workspace_;
+  const bool bySides = !request.sides.empty();
+  if (request.active.size() != m_ ||
+      (bySides ? request.sides.size() != std::size_t{m_} * w.k
+               : request.targets.rows() != m_ || request.targets.cols() != w.k)) {
+    throwUsage("ADMM: an active set or its targets do not match the " + std::to_string(m_) + " x " +
+               std::to_string(w.k) + " constraint values");
+  }
+  for (const Eigen::Index c : request.columns) {
+    if (c < 0 || c >= static_cast<Eigen::Index>(w.k)) throwUsage("ADMM: a polished column is out of range");
+  }
+  if (!w.polish) {
+    w.polish = std::make_unique<Workspace::Polish>(context_, n_, m_, w.k);
+    recordPolish();
+  }
+  Workspace::Polish& p = *w.polish;
+  if (!w.polishStartSaved) {
+    p.save.run();
+    w.polishStartSaved = true;
+  }
+
+  if (bySides) {
+    // The sides findActiveSides found are on the device already.
+    const std::vector<std::uint32_t> packed = packSides(request.sides);
+    if (packed != w.heldSides) {
+      w.heldSides.clear();
+      w.sides.upload(packed);
+      w.heldSides = packed;
+    }
+  }
+  // K_A = K0 + rho C^T diag(active) C: the ADMM's K with the active flags as row scales,
+  // formed from the sides on the device when the flags are a column's sides (the polish's
+  // sets are), else uploaded.
+  int sidesColumn = -1;
+  if (bySides && !request.columns.empty()) {
+    const auto c = static_cast<std::size_t>(request.columns.front());
+    bool fromSides = true;
+    for (std::uint32_t i = 0; i < m_ && fromSides; ++i) {
+      fromSides = (request.sides[c * m_ + i] != compute::BoundSide::Free) == (request.active[i] != 0);
+    }
+    if (fromSides) sidesColumn = static_cast<int>(c);
+  }
+  k1Current_ = false;  // K1 is the polish's from here on; the next setRho forms the ADMM's
+  longFirstSolve_ = true;
+  try {
+    if (sidesColumn >= 0) {
+      assembleK1FromRowScales(sidesColumn);
+    } else {
+      std::vector<double> flags(m_);
+      for (std::uint32_t i = 0; i < m_; ++i) flags[i] = request.active[i] ? 1.0 : 0.0;
+      assembleK1(flags);
+    }
+    assembleK(request.rho);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Numerical) throw;
+    return true;  // not factored: the ADMM's solution stands
+  }
+  info.factored = true;
+  if (bySides) {
+    recordedOnce(p.targets, context_, [&](Sequence& s) {
+      const std::uint32_t count = m_ * w.k;
+      s.dispatch(polishTargets_, {w.sides, w.lower.data(), w.upper.data(), w.z.data()}, ElementCountPush{count},
+                 groupsFor(context_, count));
+    }).run();
+  } else {
+    w.z.upload(request.targets);
+  }
+  p.begin.run();
+
+  // Only the relative tolerance stops these solves (no bound from ADMM residuals).
+  const double noBound = std::numeric_limits<double>::max();
+  w.state.upload({&noBound, 1}, kLinearTolerance2);
+  w.uploadedTolerance = -1.0;
+  double state[kStateSize];
+  w.state.download(state);
+  const double iterationsBefore = state[kInnerIterations];
+  const long maxIterations = std::max(1, settings_.linearSolver.maxIterations);
+  double previous = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < request.maxRefinements; ++r) {
+    throwIfCancelled("the polish");
+    const double solveStart = state[kInnerIterations];
+    double capped = state[kCappedSolves];
+    p.solve.run();
+    w.state.download(state);
+    while (state[kCappedSolves] > capped && state[kInnerIterations] - solveStart < maxIterations) {
+      capped = state[kCappedSolves];
+      p.resume.run();  // continues the PCG where the capped run stopped
+      w.state.download(state);
+    }
+    if (state[kCappedSolves] > capped) info.solvesConverged = false;
+    p.update.run();
+    ++info.refinements;
+    const std::vector<double> norms = w.measures.read();
+    double residual = 0.0;
+    for (const Eigen::Index c : request.columns) {
+      const double value = w.measures.at(norms, kPrimal, static_cast<std::uint32_t>(c));
+      residual = std::isnan(value) ? value : std::max(residual, value);
+      if (std::isnan(residual)) break;
+    }
+    if (!(residual > request.goal) || residual >= previous) break;  // NaN too: the caller rejects it
+    previous = residual;
+  }
+  info.linearIterations = static_cast<long>(state[kInnerIterations] - iterationsBefore);
+  if (!request.keepResult) {
+    w.x.download(x);
+    w.y.download(y);
+    return true;
+  }
+  // The refined columns join the kept result, which becomes the iterate (columns are
+  // contiguous: one copy each).
+  Sequence keep(context_);
+  keep.begin();
+  const std::size_t xBytes = std::size_t{n_} * sizeof(double), yBytes = std::size_t{m_} * sizeof(double);
+  for (const Eigen::Index c : request.columns) {
+    const auto column = static_cast<std::size_t>(c);
+    keep.copy(w.x.data(), p.xKept.data(), xBytes, column * xBytes, column * xBytes);
+    keep.copy(w.y.data(), p.yKept.data(), yBytes, column * yBytes, column * yBytes);
+  }
+  keep.barrier();
+  algebra_.copy(keep, p.xKept, w.x);
+  algebra_.copy(keep, p.yKept, w.y);
+  algebra_.copy(keep, p.z0, w.z);  // the ADMM's z again, not this refinement's targets
+  keep.end();
+  keep.run();
+  return true;
+}
+
+bool AdmmKernels::findActiveSides(std::vector<compute::BoundSide>& sides) {
+  if (!workspace_ || m_ == 0) return false;
+  Workspace& w = *workspace_;
+  const std::uint32_t count = m_ * w.k;
+  w.heldSides.clear();  // before the run: should it fail, w.sides holds nothing known
+  recordedOnce(w.findSides, context_, [&](Sequence& s) {
+    s.dispatch(activeSides_, {w.z.data(), w.y.data(), w.lower.data(), w.upper.data(), w.sides}, ElementCountPush{count},
+               groupsFor(context_, static_cast<std::uint32_t>(sideWords(count))));
+  }).run();
+  std::vector<std::uint32_t> words(sideWords(count));
+  w.sides.download(words);
+  sides.resize(count);
+  for (std::size_t e = 0; e < count; ++e) {
+    sides[e] = static_cast<compute::BoundSide>((words[e / 16] >> (2 * (e % 16))) & 3u);
+  }
+  w.heldSides = std::move(words);
+  return true;
+}
+
+double AdmmKernels::boundViolation() {
+  if (!workspace_ || m_ == 0) return 0.0;
+  Workspace& w = *workspace_;
+  recordedOnce(w.measureViolation, context_, [&](Sequence& s) {
+    const std::uint32_t count = m_ * w.k;
+    algebra_.spmv(s, devC_, w.x, w.Cx);
+    s.dispatch(boundViolation_, {w.Cx.data(), w.lower.data(), w.upper.data(), w.violation.data()}, ElementCountPush{count},
+               groupsFor(context_, count));
+    s.barrier();
+    algebra_.maxAbs(s, w.violation, w.violationNorms, 0);
+  }).run();
+  const std::vector<double> all = w.violationNorms.read();
+  double violation = 0.0;
+  for (std::uint32_t c = 0; c < w.k; ++c) {
+    const double value = w.violationNorms.at(all, 0, c);
+    if (std::isnan(value)) return value;
+    violation = std::max(violation, value);
+  }
+  return violation;
+}
+
+void AdmmKernels::discardRefinement() {
+  if (!workspace_ || !workspace_->polish || !workspace_->polishStartSaved) {
+    throwUsage("ADMM: no refinement to discard");
+  }
+  Workspace& w = *workspace_;
+  Workspace::Polish& p = *w.polish;
+  recordedOnce(p.discard, context_, [&](Sequence& s) {
+    algebra_.copy(s, p.x0, w.x);
+    algebra_.copy(s, p.y0, w.y);
+    algebra_.copy(s, p.z0, w.z);
+    algebra_.copy(s, p.x0, p.xKept);
+    algebra_.copy(s, p.y0, p.yKept);
+  }).run();
+}
+
+}  // namespace plano::vk
