@@ -381,13 +381,16 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
   double linearTolerance = std::numeric_limits<double>::infinity();
   double primalTolerance = 0.0;
   double dualTolerance = 0.0;
-  auto converged = [&]() {
+  // `regular`: a check on the checkInterval grid, which also sets what the next blocks use
+  // (the rho balance, the inner solves' bound); between them only convergence is tested.
+  auto converged = [&](bool regular = true) {
     info.primalResidual = maxOf(s.primalResidual);
     info.dualResidual = maxOf(s.dualResidual);
     const double primalScale = std::max(maxOf(s.Cx), maxOf(s.z));
     const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
     const double epsPrimal = primalAbsoluteTolerance + settings_.relativeTolerance * primalScale;
     const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
+    if (!regular) return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
     const double tiny = 1e-30;
     rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /
                            std::max(info.dualResidual / std::max(dualScale, tiny), tiny));
@@ -483,12 +486,18 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
       factoredRho_ = rho_;
       ++info.factorizations;
     }
+    // Convergence-only checks after every iteration while the inner solves are long
+    // (AdmmSettings::convergenceCheckSolveIterations), decided at each regular check.
+    bool checkEveryIteration = false;
+    int iterationsAtCheck = 0;
+    long solveIterationsAtCheck = s.linearIterations;
     while (info.iterations < settings_.maxIterations) {
       // Between check blocks the iterate is consistent: an interruption loses nothing.
       throwIfCancelled("the ADMM iteration");
       // Checks at multiples of checkInterval and at maxIterations, as in OSQP.
-      const int next = std::min(settings_.maxIterations,
-                                (info.iterations / settings_.checkInterval + 1) * settings_.checkInterval);
+      const int regularCheck = std::min(settings_.maxIterations,
+                                        (info.iterations / settings_.checkInterval + 1) * settings_.checkInterval);
+      const int next = checkEveryIteration ? info.iterations + 1 : regularCheck;
       kernels_->setLinearTolerance(linearTolerance);
       kernels_->iterate(next - info.iterations);
       info.iterations = next;
@@ -497,6 +506,22 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
         info.status = AdmmStatus::NonFinite;
         break;
       }
+      if (next < regularCheck) {
+        if (converged(false)) {
+          converged();  // the residuals and tolerances reported, as at a regular check
+          if (settings_.onCheck) {
+            settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
+          }
+          info.status = AdmmStatus::Solved;
+          break;
+        }
+        continue;
+      }
+      const int threshold = settings_.convergenceCheckSolveIterations;
+      checkEveryIteration = threshold > 0 && s.linearIterations - solveIterationsAtCheck >=
+                                                 static_cast<long>(threshold) * (info.iterations - iterationsAtCheck);
+      iterationsAtCheck = info.iterations;
+      solveIterationsAtCheck = s.linearIterations;
       const bool done = converged();
       if (settings_.onCheck) {
         settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});

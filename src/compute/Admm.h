@@ -69,6 +69,17 @@ struct AdmmSettings {
   double epsilonToleranceFraction = 0.1;
   int maxIterations = 4000;
   int checkInterval = 10;                ///< Residuals and certificates every this many iterations.
+  /// Iterations whose inner solves averaged at least this many iterations each over the
+  /// last check's block (iterative backends: PCG iterations; 0: never) are also checked
+  /// for convergence after every iteration between the regular checks, as OSQP separates
+  /// its termination checks from its rho updates. rho, the stall windows and the
+  /// certificates stay on the checkInterval grid, so the iteration is the same up to the
+  /// earlier stop. On a device a check costs about a PCG iteration (a few products and a
+  /// read-back of norms), and a stiff step's ADMM iteration hundreds: stopping at the
+  /// first converged iteration instead of the next multiple of checkInterval saves up to
+  /// checkInterval - 1 of them. A factoring backend's solves count one each, so its
+  /// iteration never changes there. The global step sets 8 (GlobalStepSettings::qp).
+  int convergenceCheckSolveIterations = 0;
   /// Stop as Stalled when, through this many iterations (0: never), the dual step
   /// ||y_k - y_k-1||_inf stayed constant to `stallChange` (relative) and the primal residual
   /// fell by less than that: y grows linearly, the mark of a problem infeasible, or

@@ -1076,6 +1076,10 @@ class RecordingBackend final : public CpuForwardingBackend {
     qp.P = P;
     qp.C = C;
     settingsUsed = settings;
+    // The tests compare the device's iteration with the host's check by check; the global
+    // step's convergence checks between them, which only long inner solves (the device's)
+    // trigger, end the device's earlier (LongInnerSolvesEndTheIterationAtItsFirstConvergedIterate).
+    settingsUsed.convergenceCheckSolveIterations = 0;
     return std::make_unique<compute::AdmmSolver>(
         std::make_unique<RecordingKernels>(compute::createHostAdmmKernels(cpu_, P, C, settings), qp), P.rows(),
         C.rows(), settings);
@@ -1156,6 +1160,38 @@ TEST_F(VulkanAdmm, EqualityRowsKeepTheHostIterationWithTheDefaultInnerTolerance)
   relativeOnly.linearToleranceFraction = 1e30;
   const AdmmRun drifting = runAdmm(context(), recorder.qp, relativeOnly, kRecordings[1]);
   EXPECT_GT(drifting.info.iterations, host.info.iterations) << "the bound made no difference on this QP";
+}
+
+TEST_F(VulkanAdmm, LongInnerSolvesEndTheIterationAtItsFirstConvergedIterate) {
+  // The 144-face exact step (multigrid, multi-dispatch): its solves take tens to hundreds of
+  // PCG iterations, so with the global step's setting the device checks convergence after
+  // every iteration between the regular checks and stops at the first converged iterate;
+  // the host's direct solves count one iteration each and keep checking every 10th.
+  // Measured: host and device without the checks 30 ADMM iterations; with them the device
+  // 22 ADMM iterations and 1 740 PCG iterations against 2 577.
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
+  compute::CpuBackend cpu;
+  compute::AdmmSettings settings = recorder.settingsUsed;
+  settings.convergenceCheckSolveIterations = projective::GlobalStepSettings{}.qp.convergenceCheckSolveIterations;
+  ASSERT_GT(settings.convergenceCheckSolveIterations, 1);
+  const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
+  ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(host.info.iterations % settings.checkInterval, 0) << "the host keeps the regular checks";
+  const AdmmRun early = runAdmm(context(), recorder.qp, settings, kRecordings[0]);
+  compute::AdmmSettings regular = settings;
+  regular.convergenceCheckSolveIterations = 0;
+  const AdmmRun late = runAdmm(context(), recorder.qp, regular, kRecordings[0]);
+  std::printf("host %d ADMM; device %d ADMM and %ld PCG with the checks, %d and %ld without\n", host.info.iterations,
+              early.info.iterations, early.info.linearIterations, late.info.iterations, late.info.linearIterations);
+  EXPECT_EQ(early.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(late.info.iterations, host.info.iterations);
+  EXPECT_LT(early.info.iterations, late.info.iterations);
+  EXPECT_GT(early.info.iterations, late.info.iterations - settings.checkInterval) << "the same rho history up to the stop";
+  EXPECT_EQ(early.info.factorizations, late.info.factorizations);
+  EXPECT_LT(early.info.linearIterations, late.info.linearIterations);
+  // Converged: within the ADMM's tolerances of the host's solution, as the later stop is.
+  EXPECT_LT(relativeDifference(early.x, host.x), 1e-5);
 }
 
 TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgIterations) {
