@@ -57,6 +57,22 @@ void AdmmKernels::recordPolish() {
   p.update.end();
 }
 
+Sequence& AdmmKernels::recordedMomentum(int step, double beta) {
+  Workspace& w = *workspace_;
+  Workspace::Polish& p = *w.polish;
+  if (p.momentum.size() <= static_cast<std::size_t>(step)) p.momentum.resize(static_cast<std::size_t>(step) + 1);
+  return recordedOnce(p.momentum[static_cast<std::size_t>(step)], context_, [&](Sequence& s) {
+    LinearAlgebra& la = algebra_;
+    if (beta == 0.0) {
+      la.copy(s, w.y, w.yPrevious);
+      return;
+    }
+    la.copy(s, w.y, w.dy);  // dy: scratch until the update
+    la.axpby(s, -beta, w.yPrevious, 1.0 + beta, w.y);
+    la.copy(s, w.dy, w.yPrevious);
+  });
+}
+
 bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x,
                                   Eigen::MatrixXd& y, compute::ActiveSetRefinementInfo& info) {
   // No iterate (k = 0), or no rows to hold (m = 0: the host's unconstrained solve; the
@@ -140,8 +156,32 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   const double iterationsBefore = state[kInnerIterations];
   const long maxIterations = std::max(1, settings_.linearSolver.maxIterations);
   double previous = std::numeric_limits<double>::infinity();
+  // The method of multipliers is gradient ascent on the multipliers, slow along the
+  // constraints' small singular values: with PCG's penalty (kIterativePolishRho) the
+  // ~256-face exact step's polish runs into its 30-refinement cap, its residual falling by
+  // ~0.7 per refinement. Where two plain refinements show such a slow contraction (above
+  // kSlowContraction), Nesterov's momentum accelerates the next ones, restarted (a plain
+  // refinement that decides again) when the residual grows; a plain refinement that does
+  // not reduce it ends them (the rounding floor), as before. Fast contractions keep the
+  // plain method, whose next refinement starts at the solution within rounding. Measured
+  // on that step (lavapipe, 30 refinements): residual 8.0e-12 -> 3.3e-14, polish PCG
+  // iterations 2 599 -> 2 268; with exact solves on its matrices, refinements to 1e-12:
+  // 256 faces 51 -> 38, 1k faces 615 -> 128.
+  constexpr double kSlowContraction = 0.5;
+  double t = 1.0;
+  int sinceRestart = 0;
+  bool accelerate = false;
   for (int r = 0; r < request.maxRefinements; ++r) {
     throwIfCancelled("the polish");
+    if (!accelerate) {
+      t = 1.0;
+      sinceRestart = 0;
+    }
+    const double tNext = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t));
+    const double beta = (t - 1.0) / tNext;
+    t = tNext;
+    const bool plain = beta == 0.0;
+    recordedMomentum(sinceRestart++, beta).run();
     const double solveStart = state[kInnerIterations];
     double capped = state[kCappedSolves];
     p.solve.run();
@@ -161,7 +201,13 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
       residual = std::isnan(value) ? value : std::max(residual, value);
       if (std::isnan(residual)) break;
     }
-    if (!(residual > request.goal) || residual >= previous) break;  // NaN too: the caller rejects it
+    if (!(residual > request.goal)) break;  // NaN too: the caller rejects it
+    if (residual >= previous) {
+      if (plain) break;    // the rounding floor
+      accelerate = false;  // restart: a plain refinement next, which decides again
+    } else if (plain) {
+      accelerate = residual > kSlowContraction * previous;
+    }
     previous = residual;
   }
   info.linearIterations = static_cast<long>(state[kInnerIterations] - iterationsBefore);

@@ -210,6 +210,10 @@ struct AdmmKernels::Workspace {
     Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
     std::unique_ptr<Sequence> targets;  ///< z = b from the held sides (recorded on first use).
     std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0, z = z0 (recorded on first use).
+    /// Nesterov's extrapolation of the multipliers before refinement j after a restart:
+    /// lambda += beta_j (lambda - lambda'), lambda' = lambda (yPrevious holds lambda'); entry
+    /// 0 only remembers lambda (beta_1 = 0). Recorded on first use.
+    std::vector<std::unique_ptr<Sequence>> momentum;
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
