@@ -390,6 +390,8 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
     const double epsPrimal = primalAbsoluteTolerance + settings_.relativeTolerance * primalScale;
     const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
+    primalTolerance = epsPrimal;
+    dualTolerance = epsDual;
     if (!regular) return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
     const double tiny = 1e-30;
     rhoBalance = std::sqrt((info.primalResidual / std::max(primalScale, tiny)) /
@@ -398,8 +400,6 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     const double fraction = settings_.linearToleranceFraction;
     linearTolerance = std::min(linearTolerance, fraction * std::max(std::min(info.primalResidual, info.dualResidual),
                                                                     std::min(epsPrimal, epsDual)));
-    primalTolerance = epsPrimal;
-    dualTolerance = epsDual;
     return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
   };
 
@@ -508,7 +508,6 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
       }
       if (next < regularCheck) {
         if (converged(false)) {
-          converged();  // the residuals and tolerances reported, as at a regular check
           if (settings_.onCheck) {
             settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
           }
