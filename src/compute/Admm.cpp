@@ -491,6 +491,13 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     bool checkEveryIteration = false;
     int iterationsAtCheck = 0;
     long solveIterationsAtCheck = s.linearIterations;
+    double primalAtCheck = info.primalResidual, dualAtCheck = info.dualResidual;
+    // Whether a residual that fell from `before` to `now` over the last block, at that rate,
+    // meets `tolerance` within the next block (met already counts).
+    const auto withinABlock = [](double before, double now, double tolerance) {
+      if (now <= tolerance) return true;
+      return now < before && std::log(tolerance / now) / std::log(now / before) <= 1.0;
+    };
     while (info.iterations < settings_.maxIterations) {
       // Between check blocks the iterate is consistent: an interruption loses nothing.
       throwIfCancelled("the ADMM iteration");
@@ -517,11 +524,17 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
         continue;
       }
       const int threshold = settings_.convergenceCheckSolveIterations;
-      checkEveryIteration = threshold > 0 && s.linearIterations - solveIterationsAtCheck >=
-                                                 static_cast<long>(threshold) * (info.iterations - iterationsAtCheck);
+      const bool longSolves = threshold > 0 && s.linearIterations - solveIterationsAtCheck >=
+                                                   static_cast<long>(threshold) * (info.iterations - iterationsAtCheck);
       iterationsAtCheck = info.iterations;
       solveIterationsAtCheck = s.linearIterations;
       const bool done = converged();
+      // Only a block expected to converge is checked iteration by iteration: a long
+      // attempt's checks would otherwise cost more than the few iterations they save.
+      checkEveryIteration = longSolves && withinABlock(primalAtCheck, info.primalResidual, primalTolerance) &&
+                            withinABlock(dualAtCheck, info.dualResidual, dualTolerance);
+      primalAtCheck = info.primalResidual;
+      dualAtCheck = info.dualResidual;
       if (settings_.onCheck) {
         settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
       }
