@@ -1168,7 +1168,7 @@ TEST_F(VulkanAdmm, LongInnerSolvesEndTheIterationAtItsFirstConvergedIterate) {
   // every iteration between the regular checks and stops at the first converged iterate;
   // the host's direct solves count one iteration each and keep checking every 10th.
   // Measured: host and device without the checks 30 ADMM iterations; with them the device
-  // 22 ADMM iterations and 1 740 PCG iterations against 2 577.
+  // 22 ADMM iterations and 1 548 PCG iterations against 2 577.
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
   compute::CpuBackend cpu;
