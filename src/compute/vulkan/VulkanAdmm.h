@@ -198,9 +198,9 @@ class AdmmKernels final : public compute::AdmmKernels {
 
  private:
   struct Workspace;  // vectors, scalars and recorded sequences for one column count k
-  /// The polish's momentum before its `step`-th refinement since a restart (beta as the
-  /// refinement loop computes it, a function of the step), recorded on first use.
-  Sequence& recordedMomentum(int step, double beta);
+  /// The polish's Nesterov momentum before its `step`-th refinement since a restart (step 0
+  /// only remembers the multipliers), recorded on first use.
+  Sequence& recordedMomentum(int step);
   /// A recorded PCG iteration count, at most the linear solver's maxIterations (and at least 1).
   int withinSolverLimit(int iterations) const {
     return std::min(iterations, std::max(1, settings_.linearSolver.maxIterations));

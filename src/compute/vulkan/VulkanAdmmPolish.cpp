@@ -57,7 +57,20 @@ void AdmmKernels::recordPolish() {
   p.update.end();
 }
 
-Sequence& AdmmKernels::recordedMomentum(int step, double beta) {
+namespace {
+
+/// Nesterov's momentum before refinement `step` after a restart: (t_step - 1) / t_step+1
+/// with t_0 = 1, t_i+1 = (1 + sqrt(1 + 4 t_i^2)) / 2 (0 for step 0).
+double nesterovMomentum(int step) {
+  double t = 1.0;
+  for (int i = 0; i < step; ++i) t = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t));
+  return (t - 1.0) / (0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t)));
+}
+
+}  // namespace
+
+Sequence& AdmmKernels::recordedMomentum(int step) {
+  const double beta = nesterovMomentum(step);
   Workspace& w = *workspace_;
   Workspace::Polish& p = *w.polish;
   if (p.momentum.size() <= static_cast<std::size_t>(step)) p.momentum.resize(static_cast<std::size_t>(step) + 1);
@@ -168,20 +181,13 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // iterations 2 599 -> 2 268 (BM_GlobalStep/vulkan/256; the bound in
   // VulkanAdmm.ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor).
   constexpr double kSlowContraction = 0.5;
-  double t = 1.0;
   int sinceRestart = 0;
   bool accelerate = false;
   for (int r = 0; r < request.maxRefinements; ++r) {
     throwIfCancelled("the polish");
-    if (!accelerate) {
-      t = 1.0;
-      sinceRestart = 0;
-    }
-    const double tNext = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t));
-    const double beta = (t - 1.0) / tNext;
-    t = tNext;
-    const bool plain = beta == 0.0;
-    recordedMomentum(sinceRestart++, beta).run();
+    if (!accelerate) sinceRestart = 0;
+    const bool plain = sinceRestart == 0;
+    recordedMomentum(sinceRestart++).run();
     const double solveStart = state[kInnerIterations];
     double capped = state[kCappedSolves];
     p.solve.run();
