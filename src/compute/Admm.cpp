@@ -39,9 +39,11 @@ bool allFinite(const Eigen::VectorXd& v) { return v.allFinite(); }
 class HostAdmmKernels final : public AdmmKernels {
  public:
   HostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C, const AdmmSettings& settings)
-      : backend_(backend), settings_(settings), P_(P), C_(C), Ct_(C.transpose()) {
+      : backend_(backend), settings_(settings), alpha_(settings.relaxation), P_(P), C_(C), Ct_(C.transpose()) {
     C_.makeCompressed();
   }
+
+  void setRelaxation(double alpha) override { alpha_ = alpha; }
 
   void setRho(const std::vector<char>& equality, double rho) override {
     rho_.resize(static_cast<Eigen::Index>(equality.size()));
@@ -92,7 +94,7 @@ class HostAdmmKernels final : public AdmmKernels {
   }
 
   void iterate(int count) override {
-    const double alpha = settings_.relaxation;
+    const double alpha = alpha_;
     for (int i = 0; i < count; ++i) {
       const Eigen::MatrixXd rhs = settings_.sigma * x_ - q_ + Ct_ * (rho_.asDiagonal() * z_ - y_);
       linearIterations_ += solver_->solve(rhs, xTilde_).iterations;
@@ -141,6 +143,7 @@ class HostAdmmKernels final : public AdmmKernels {
  private:
   Backend& backend_;
   AdmmSettings settings_;
+  double alpha_;
   SparseMatrix P_, C_, Ct_;
   ConstraintScaling scaling_;
   std::unique_ptr<SpdSolver> solver_;
@@ -183,6 +186,9 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
   }
   if (!(settings_.stallChange >= 0.0 && settings_.stallChange < 1.0)) {
     throwUsage("ADMM: stallChange must be in [0, 1)");
+  }
+  for (const double alpha : {settings_.relaxation, settings_.equalityRelaxation}) {
+    if (!(alpha > 0.0 && alpha < 2.0)) throwUsage("ADMM: the over-relaxations must be in (0, 2)");
   }
   if (std::isnan(settings_.inaccurateDualFactor)) throwUsage("ADMM: inaccurateDualFactor must be a number");
   if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
@@ -362,6 +368,8 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
 
   std::vector<char> equality(m_);
   for (Eigen::Index i = 0; i < m_; ++i) equality[i] = (lower.row(i).array() == upper.row(i).array()).all();
+  const bool allEqualities = std::all_of(equality.begin(), equality.end(), [](char e) { return e != 0; });
+  kernels_->setRelaxation(allEqualities ? settings_.equalityRelaxation : settings_.relaxation);
   AdmmInfo info;
   if (relaxed) {
     kernels_->startRelaxed(q, *relaxed, x, y);

@@ -1059,6 +1059,7 @@ class RecordingKernels final : public compute::AdmmKernels {
     }
     inner_->start(q, lower, upper, x, y);
   }
+  void setRelaxation(double alpha) override { inner_->setRelaxation(alpha); }
   void iterate(int count) override { inner_->iterate(count); }
   compute::AdmmMeasures measure() override { return inner_->measure(); }
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override { inner_->download(x, y, z); }
@@ -1167,12 +1168,15 @@ TEST_F(VulkanAdmm, LongInnerSolvesEndTheIterationAtItsFirstConvergedIterate) {
   // PCG iterations, so with the global step's setting the device checks convergence after
   // every iteration between the regular checks and stops at the first converged iterate;
   // the host's direct solves count one iteration each and keep checking every 10th.
-  // Measured: host and device without the checks 30 ADMM iterations; with them the device
-  // 22 ADMM iterations and 1 548 PCG iterations against 2 577.
+  // Iterated as an attempt with inequality rows is (OSQP's over-relaxation; this all-equality
+  // attempt's own, AdmmSettings::equalityRelaxation, converges at the 20th iteration, a
+  // regular check). Measured: host and device without the checks 30 ADMM iterations; with
+  // them the device 22 ADMM iterations and 1 548 PCG iterations against 2 577.
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
   compute::CpuBackend cpu;
   compute::AdmmSettings settings = recorder.settingsUsed;
+  settings.equalityRelaxation = settings.relaxation;
   settings.convergenceCheckSolveIterations = projective::GlobalStepSettings{}.qp.convergenceCheckSolveIterations;
   ASSERT_GT(settings.convergenceCheckSolveIterations, 1);
   const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
@@ -1199,12 +1203,16 @@ TEST_F(VulkanAdmm, ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor)
   // multipliers contract its residual by ~0.7 each. With the momentum that two slow plain
   // refinements switch on, measured from the ADMM's 1.8e-8 to the goal of 1e-13: 18
   // refinements and 1 010 PCG iterations (5.4e-14), against 27 and 1 294 (7.6e-14) with
-  // plain refinements alone.
+  // plain refinements alone. (From the ADMM iterated with OSQP's over-relaxation, as these
+  // figures were; with the all-equality attempts' own, AdmmSettings::equalityRelaxation,
+  // the ADMM stops at 3.1e-7 and the polish takes 29 refinements.)
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(16, recorder));
   const BoxQp& qp = recorder.qp;
   ASSERT_TRUE((qp.lower.array() == qp.upper.array()).all()) << "every row an equality";
-  auto solver = deviceSolver(context(), qp, recorder.settingsUsed, kRecordings[0]);
+  compute::AdmmSettings settings = recorder.settingsUsed;
+  settings.equalityRelaxation = settings.relaxation;
+  auto solver = deviceSolver(context(), qp, settings, kRecordings[0]);
   const AdmmRun admm = runAdmm(*solver, qp);
   ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
   const std::vector<char> active(static_cast<std::size_t>(qp.C.rows()), 1);
@@ -1229,7 +1237,9 @@ TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgItera
   // and their blocks run again with larger caps. Measured: host 30 ADMM iterations; face
   // blocks 30 ADMM with 12 208 PCG iterations (the blocks run again included; before they
   // were, 40 ADMM with 5 438, the inexact steps having moved the rho balance); multigrid 30
-  // ADMM with 2 577.
+  // ADMM with 2 577. With the all-equality attempts' over-relaxation
+  // (AdmmSettings::equalityRelaxation, 1.3 instead of 1.6): host and multigrid 20 ADMM,
+  // 1 323 PCG, the device's x 7.4e-7 from the host's, both within 7.5e-7 of the KKT solution.
   RecordingBackend recorder;
   ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(12, recorder));
   compute::CpuBackend cpu;

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "compute/cpu/CpuBackend.h"
 #include "core/Error.h"
@@ -145,6 +147,60 @@ TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
   EXPECT_EQ(info.iterations, freshInfo.iterations);
   EXPECT_EQ(info.rho, freshInfo.rho);
   EXPECT_LT((x - xFresh).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(BoxQp, AnAllEqualityAdmmSolveIsNotOverRelaxed) {
+  // Its rows are stiff (rho c^2 >> 1 at the equality rows' rho): the iteration, the method
+  // of multipliers there, shrinks their error by |1 - alpha| per iteration, 0.3 with
+  // AdmmSettings::equalityRelaxation against 0.6 with OSQP's alpha (measured: 12 and 26
+  // iterations).
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 17);
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.equalitySolve = EqualitySolve::Admm;
+  settings.checkInterval = 1;
+  settings.polish = false;
+  Eigen::MatrixXd x, y;
+  const BoxQpInfo info = solveOnNewSolver(backend, qp, settings, x, y);
+  ASSERT_EQ(info.status, BoxQpStatus::Solved);
+
+  BoxQpSettings overRelaxed = settings;
+  overRelaxed.equalityRelaxation = overRelaxed.relaxation;
+  Eigen::MatrixXd xOver, yOver;
+  const BoxQpInfo overInfo = solveOnNewSolver(backend, qp, overRelaxed, xOver, yOver);
+  ASSERT_EQ(overInfo.status, BoxQpStatus::Solved);
+  EXPECT_LT(2 * info.iterations, overInfo.iterations);
+  EXPECT_LT((x - xOver).cwiseAbs().maxCoeff(), 1e-5);
+
+  for (const double alpha : {0.0, 2.0, std::nan("")}) {
+    BoxQpSettings wrong = settings;
+    wrong.equalityRelaxation = alpha;
+    EXPECT_THROW(solveOnNewSolver(backend, qp, wrong, x, y), Error) << alpha;
+  }
+}
+
+TEST(BoxQp, AProblemWithAnInequalityRowKeepsTheOverRelaxation) {
+  // One row of the equality problem widened to a box that it meets loosely: an OSQP
+  // problem like any other, iterated with AdmmSettings::relaxation whatever
+  // equalityRelaxation says.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 17);
+  Eigen::MatrixXd lower = qp.d, upper = qp.d;
+  lower.row(0).array() -= 10.0;
+  upper.row(0).array() += 10.0;
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.checkInterval = 1;
+  settings.polish = false;
+  std::vector<int> iterations;
+  for (const double alpha : {1.0, 1.6}) {
+    settings.equalityRelaxation = alpha;
+    BoxQpSolver solver(backend, qp.P, qp.C, settings);
+    Eigen::MatrixXd x, y;
+    const BoxQpInfo info = solver.solve(qp.q, lower, upper, x, y);
+    ASSERT_EQ(info.status, BoxQpStatus::Solved);
+    iterations.push_back(info.iterations);
+  }
+  EXPECT_EQ(iterations[0], iterations[1]);
 }
 
 /// The CPU reference, counting the SPD solvers it is asked for; with `failFirst`, the

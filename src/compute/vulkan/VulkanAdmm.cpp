@@ -131,6 +131,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
                          std::uint32_t unitsPerDispatch)
     : context_(context),
       settings_(settings),
+      relaxation_(settings.relaxation),
       n_(elementCount(P.rows(), "the ADMM's unknown count")),
       m_(elementCount(C.rows(), "the ADMM's constraint count")),
       C_(C),

@@ -161,6 +161,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// startRelaxed with epsilon 0, then boundViolation(): one check-sized read.
   std::optional<double> violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                                     const compute::DeviceMatrix& x) override;
+  void setRelaxation(double alpha) override { relaxation_ = alpha; }
   void iterate(int count) override;
   compute::AdmmMeasures measure() override;
   void setLinearTolerance(double tolerance) override;
@@ -269,6 +270,7 @@ class AdmmKernels final : public compute::AdmmKernels {
 
   Context& context_;
   compute::AdmmSettings settings_;
+  double relaxation_;                ///< The over-relaxation of the blocks run next (setRelaxation).
   std::uint32_t n_;
   std::uint32_t m_;
   compute::SparseMatrix C_;          ///< Its values may be stale after setConstraintScales.

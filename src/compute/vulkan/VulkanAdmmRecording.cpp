@@ -139,7 +139,7 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
   recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, false, countLargest, position);
 
   // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
-  const double alpha = settings_.relaxation;
+  const double alpha = relaxation_;
   la.spmv(s, devC_, w.xTilde, w.zTilde);
   la.axpby(s, alpha, w.xTilde, 1.0 - alpha, w.x);
   s.dispatch(update_,
@@ -155,7 +155,7 @@ void AdmmKernels::recordSingleWorkgroup(Sequence& s, int count, int dispatches, 
   const DescriptorSet& set = *w.singleWorkgroupSet;
   for (int d = 0; d < dispatches; ++d) {
     const SingleWorkgroupPush push{n_,    m_,    w.k, static_cast<std::uint32_t>(count), cap, w.budget,
-                                   begin && d == 0 ? 1u : 0u, block_, settings_.sigma, settings_.relaxation,
+                                   begin && d == 0 ? 1u : 0u, block_, settings_.sigma, relaxation_,
                                    tolerance * tolerance};
     s.dispatch(singleWorkgroup_, set, push, 1);
     s.barrier();
@@ -170,7 +170,7 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
   const double units = count * (w.expectedInnerIterations + 2.0);
   int dispatches = 1;
   while (dispatches < 4096 && dispatches * static_cast<double>(w.budget) < units) dispatches *= 2;
-  recordedOnce(w.blocks[count * 8192 + dispatches], context_, [&](Sequence& s) {
+  recordedOnce(w.blocks[{relaxation_, count * 8192 + dispatches}], context_, [&](Sequence& s) {
     recordSingleWorkgroup(s, count, dispatches, true);
   }).run();
   // One read-back per run: the position tells whether the block is done.
@@ -189,7 +189,7 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
 
 Sequence& AdmmKernels::block(int count, bool longFirstSolve) {
   Workspace& w = *workspace_;
-  auto& slot = w.blocks[2 * count + (longFirstSolve ? 1 : 0)];
+  auto& slot = w.blocks[{relaxation_, 2 * count + (longFirstSolve ? 1 : 0)}];
   return recordedOnce(slot, context_, [&](Sequence& s) {
     const int largest = withinSolverLimit(kMaxInnerIterations);
     // A capped solve makes measure() run this block again, from the iteration of that solve,

@@ -190,9 +190,11 @@ struct AdmmKernels::Workspace {
   /// the device (recordStart), by startKey; recorded on first use.
   std::map<int, std::unique_ptr<Sequence>> starts;
   Sequence check;  ///< The inf-norms of AdmmMeasures.
-  /// Recorded blocks: multi-dispatch by 2 * iteration count + (first solve long),
-  /// single-workgroup by 8192 * iteration count + dispatch count.
-  std::map<int, std::unique_ptr<Sequence>> blocks;
+  /// Recorded blocks by their over-relaxation (a push constant) and: multi-dispatch by
+  /// 2 * iteration count + (first solve long), single-workgroup by 8192 * iteration count +
+  /// dispatch count. An ε schedule alternates between two relaxations (all-equality
+  /// attempts and the others), so each keeps its blocks.
+  std::map<std::pair<double, int>, std::unique_ptr<Sequence>> blocks;
   /// refineActiveSet's: the iterate it starts every call from (saved by its first call
   /// after start() or iterate()), and its recordings.
   struct Polish {
