@@ -93,8 +93,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Recorded PCG iterations per run of a polish solve (refineActiveSet), which continues
   /// until the solve converges: the recorded ones past convergence still cost their
   /// (empty) dispatches. Warm-started at the ADMM's solution a solve that only needs to
-  /// meet tol ||b|| takes tens of iterations; one to tol ||r0|| (SolveTarget::WarmStart)
-  /// hundreds (8x8 grid deformation: about 2 500 per polish of 5-7 refinements, before the
+  /// meet tol ||b|| takes tens of iterations; one to tol ||r0|| (SolveTarget::WarmStart,
+  /// with the ADMM's tol of 1e-10, before kPolishSolveTolerance) hundreds (8x8 grid deformation: about 2 500 per polish of 5-7 refinements, before the
   /// rounding floor below).
   static constexpr int kPolishInnerIterations = 64;
   /// Recorded PCG iterations of each continuation of a polish solve past that cap (even:
@@ -108,6 +108,20 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// PCG iterations instead of 113 224, and agrees with the CPU to 4.4e-12 of the diagonal
   /// (6.7e-13 without the floor; 1.7e-12 with 4e-15, 91 922 iterations).
   static constexpr double kPolishRoundingFloor = 1e-14;
+  /// The target of a polish solve with momentum, relative to its warm start's residual:
+  /// ||r|| <= this times ||r0|| (plain refinements keep the inner solves' 1e-10). A
+  /// refinement of the method of multipliers needs its step only to a fraction of the
+  /// step's own size (an inexact augmented Lagrangian method), the more so where each
+  /// refinement gains little: the accelerated ones run where the residual contracts by 0.5
+  /// or less per refinement, and r0 shrinks with it. Plain refinements contract fast (~40x
+  /// each on the 8x8 grid deformation's polish), which such steps would spoil (there 0.58
+  /// for the first with 1e-2, and 30 refinements instead of 5), and they decide the
+  /// rounding floor. Measured on the ~256-face exact step's polish, from the ADMM's 1.8e-8
+  /// to 1e-13 (VulkanAdmm.ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor), PCG
+  /// iterations / refinements / max |x - x_KKT| with every refinement's solves to a
+  /// fraction of ||r0||: 1e-10 1 010 / 18 / 3.3e-11; 1e-3 695 / 18 / 3.4e-11; 1e-2 422 /
+  /// 18 / 3.6e-11; 1e-1 298 / 24 / 5.6e-11 (the refinements' progress then suffers).
+  static constexpr double kPolishSolveTolerance = 1e-2;
   /// Automatic recording uses one workgroup up to this many unknowns per column: one
   /// workgroup then sweeps a vector in at most a few hundred rows per invocation.
   static constexpr std::uint32_t kSingleWorkgroupUnknowns = 1u << 16;
@@ -258,9 +272,11 @@ class AdmmKernels final : public compute::AdmmKernels {
     bool first;            ///< The block's first solve: notes the capped solves so far.
     bool abandonAfterCap;  ///< Skipped when a solve of the block before it was capped.
   };
-  /// `countLargest`: the solve's iterations count into the longest solve (kMinInnerIterations).
-  void recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target = SolveTarget::RightHandSide,
-                        bool firstOdd = false, bool countLargest = false, BlockPosition position = {});
+  /// `tolerance`: the relative one of the target (of ||b|| or ||r0||; a continuation's must
+  /// be its solve's). `countLargest`: the solve's iterations count into the longest solve
+  /// (kMinInnerIterations).
+  void recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, double tolerance, bool firstOdd = false,
+                        bool countLargest = false, BlockPosition position = {});
   void recordIteration(Sequence& s, bool saveDual, int innerIterations, bool countLargest, BlockPosition position);
   void recordPolish();
   void recordSingleWorkgroup(Sequence& s, int count, int dispatches, bool begin);

@@ -37,13 +37,24 @@ void AdmmKernels::recordPolish() {
   p.solve.begin();
   recordRightHandSide(p.solve);
   la.copy(p.solve, w.x, w.xTilde);
-  recordInnerSolve(p.solve, cap, SolveTarget::WarmStart);
+  recordInnerSolve(p.solve, cap, SolveTarget::WarmStart, settings_.linearSolver.relativeTolerance);
   p.solve.end();
   // A solve that needs more continues where it stopped, not restarted: a PCG restarted
   // every few dozen iterations converges far slower on the stiff K_A.
   p.resume.begin();
-  recordInnerSolve(p.resume, kPolishResumeIterations, SolveTarget::Continuation, cap % 2 == 1);
+  recordInnerSolve(p.resume, kPolishResumeIterations, SolveTarget::Continuation,
+                   settings_.linearSolver.relativeTolerance, cap % 2 == 1);
   p.resume.end();
+  // The same to kPolishSolveTolerance ||r0||: the refinements with momentum.
+  p.looseSolve.begin();
+  recordRightHandSide(p.looseSolve);
+  la.copy(p.looseSolve, w.x, w.xTilde);
+  recordInnerSolve(p.looseSolve, cap, SolveTarget::WarmStart, kPolishSolveTolerance);
+  p.looseSolve.end();
+  p.looseResume.begin();
+  recordInnerSolve(p.looseResume, kPolishResumeIterations, SolveTarget::Continuation, kPolishSolveTolerance,
+                   cap % 2 == 1);
+  p.looseResume.end();
   // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
   // lambda reaches it).
   p.update.begin();
@@ -179,7 +190,9 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // plain method, whose next refinement starts at the solution within rounding. Measured
   // on that step (lavapipe, 30 refinements): residual 8.0e-12 -> 3.3e-14, polish PCG
   // iterations 2 599 -> 2 268 (BM_GlobalStep/vulkan/256; the bound in
-  // VulkanAdmm.ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor).
+  // VulkanAdmm.ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor). The
+  // accelerated refinements solve only to kPolishSolveTolerance of their warm start's
+  // residual.
   constexpr double kSlowContraction = 0.5;
   int sinceRestart = 0;
   bool accelerate = false;
@@ -190,11 +203,11 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     recordedMomentum(sinceRestart++).run();
     const double solveStart = state[kInnerIterations];
     double capped = state[kCappedSolves];
-    p.solve.run();
+    (plain ? p.solve : p.looseSolve).run();
     w.state.download(state);
     while (state[kCappedSolves] > capped && state[kInnerIterations] - solveStart < maxIterations) {
       capped = state[kCappedSolves];
-      p.resume.run();  // continues the PCG where the capped run stopped
+      (plain ? p.resume : p.looseResume).run();  // continues the PCG where the capped run stopped
       w.state.download(state);
     }
     if (state[kCappedSolves] > capped) info.solvesConverged = false;

@@ -73,7 +73,7 @@ void AdmmKernels::recordPcgStart(Sequence& s, SolveTarget target) {
   la.dot(s, w.rhs, w.Kp, w.pcg, target == SolveTarget::RightHandSide ? kPcgBz : kPcgRhsBz);
 }
 
-void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, bool firstOdd,
+void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget target, double tolerance, bool firstOdd,
                                    bool countLargest, BlockPosition position) {
   Workspace& w = *workspace_;
   const std::uint32_t k = w.k;
@@ -88,7 +88,7 @@ void AdmmKernels::recordInnerSolve(Sequence& s, int innerIterations, SolveTarget
   const std::uint32_t groups = w.pcg.groups();
   // The direction update's and the V-cycle's sweeps (vk::Multigrid::record).
   const std::uint32_t directionGroups = sweepGroupsFor(context_, nk);
-  const double tolerance2 = settings_.linearSolver.relativeTolerance * settings_.linearSolver.relativeTolerance;
+  const double tolerance2 = tolerance * tolerance;
   // The polish's solves (tol ||r0||) stop at the rounding floor of ||b|| too.
   const std::uint32_t floorSlot = target == SolveTarget::RightHandSide ? kNoFloor : kPcgRhsBz;
   const double floor2 = kPolishRoundingFloor * kPolishRoundingFloor;
@@ -136,7 +136,8 @@ void AdmmKernels::recordIteration(Sequence& s, bool saveDual, int innerIteration
   const std::uint32_t mk = m_ * w.k;
 
   recordRightHandSide(s);
-  recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, false, countLargest, position);
+  recordInnerSolve(s, innerIterations, SolveTarget::RightHandSide, settings_.linearSolver.relativeTolerance, false,
+                   countLargest, position);
 
   // zTilde = C xTilde, x = alpha xTilde + (1 - alpha) x, then the z and y updates.
   const double alpha = relaxation_;

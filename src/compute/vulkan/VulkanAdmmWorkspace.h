@@ -201,7 +201,8 @@ struct AdmmKernels::Workspace {
     Polish(Context& context, std::uint32_t n, std::uint32_t m, std::uint32_t k)
         : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"),
           z0(context, m, k, "polish start z"), xKept(context, n, k, "polish result x"), yKept(context, m, k, "polish result y"), save(context),
-          begin(context), solve(context), resume(context), update(context) {}
+          begin(context), solve(context), resume(context), looseSolve(context), looseResume(context),
+          update(context) {}
     DeviceVectors x0, y0;
     DeviceVectors z0;  ///< The ADMM's z: each refinement sets z to its targets, the end restores it.
     DeviceVectors xKept, yKept;  ///< keepResult's: the columns refined since the save, the others x0, y0.
@@ -209,6 +210,8 @@ struct AdmmKernels::Workspace {
     Sequence begin;   ///< x = x0, lambda = y = diag(active) y0
     Sequence solve;   ///< The refinement's right-hand side and PCG from xTilde = x.
     Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
+    /// solve and resume to kPolishSolveTolerance ||r0||: the refinements with momentum.
+    Sequence looseSolve, looseResume;
     Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
     std::unique_ptr<Sequence> targets;  ///< z = b from the held sides (recorded on first use).
     std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0, z = z0 (recorded on first use).
