@@ -94,8 +94,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// until the solve converges: the recorded ones past convergence still cost their
   /// (empty) dispatches. Warm-started at the ADMM's solution a solve that only needs to
   /// meet tol ||b|| takes tens of iterations; one to tol ||r0|| (SolveTarget::WarmStart,
-  /// with the ADMM's tol of 1e-10, before kPolishSolveTolerance) hundreds (8x8 grid deformation: about 2 500 per polish of 5-7 refinements, before the
-  /// rounding floor below).
+  /// with the ADMM's tol of 1e-10) hundreds (8x8 grid deformation: about 2 500 per polish
+  /// of 5-7 refinements, before the rounding floor below).
   static constexpr int kPolishInnerIterations = 64;
   /// Recorded PCG iterations of each continuation of a polish solve past that cap (even:
   /// a continuation keeps the parity of the r.z slots).
