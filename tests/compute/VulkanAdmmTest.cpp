@@ -558,6 +558,34 @@ TEST_F(VulkanAdmm, ResumingAfterEveryUnitOfWorkChangesNothing) {
   EXPECT_EQ(resumed.y, whole.y);
 }
 
+TEST_F(VulkanAdmm, ResumedBlocksKeepTheOverRelaxationOfTheirSolve) {
+  // An all-equality solve iterates with AdmmSettings::equalityRelaxation, any other with
+  // relaxation, and the single-workgroup recordings hold it, those that resume a block
+  // included. A box solve, then an all-equality one whose stiffer solves outrun the
+  // dispatches the first one's work suggested, on one solver (its resumes recorded by the
+  // box solve), are bit for bit those of new solvers started at the same rho. (Resumes
+  // kept by dispatch count alone gave the second solve the box's alpha.)
+  const BoxQp box = randomBoxQp(100, 75, 4);
+  BoxQp equalities = box;
+  equalities.lower = 0.5 * (box.lower + box.upper);
+  equalities.upper = equalities.lower;
+  const compute::AdmmSettings settings = tightSettings();
+  ASSERT_NE(settings.relaxation, settings.equalityRelaxation);
+  const Recording resuming{"single workgroup, 128 units per dispatch", vk::AdmmRecording::SingleWorkgroup, 128};
+  auto kept = deviceSolver(context(), box, settings, resuming);
+  int solve = 0;
+  for (const BoxQp* qp : std::vector<const BoxQp*>{&box, &equalities}) {
+    SCOPED_TRACE("solve " + std::to_string(solve++));
+    auto fresh = deviceSolver(context(), box, settings, resuming);
+    fresh->setRho(kept->rho());
+    const AdmmRun reference = runAdmm(*fresh, *qp), run = runAdmm(*kept, *qp);
+    ASSERT_EQ(reference.info.status, compute::AdmmStatus::Solved);
+    EXPECT_EQ(run.info.iterations, reference.info.iterations);
+    EXPECT_EQ(run.x, reference.x);
+    EXPECT_EQ(run.y, reference.y);
+  }
+}
+
 TEST_F(VulkanAdmm, SmallProblemsRunInOneWorkgroupAndWideOnesRefuseIt) {
   const BoxQp qp = randomBoxQp(40, 30, 3);
   const compute::AdmmSettings settings;

@@ -179,7 +179,7 @@ void AdmmKernels::iterateSingleWorkgroup(int count) {
   w.state.download(state);
   while (state[kRemaining] > 0.0) {
     throwIfCancelled("the ADMM iteration");
-    recordedOnce(w.resumes[dispatches], context_, [&](Sequence& s) {
+    recordedOnce(w.resumes[{relaxation_, dispatches}], context_, [&](Sequence& s) {
       recordSingleWorkgroup(s, count, dispatches, false);
     }).run();
     w.state.download(state);

@@ -162,7 +162,8 @@ struct AdmmKernels::Workspace {
   double expectedInnerIterations = 16.0;     ///< Per solve, from the last block (sizes recordings).
   double innerIterationsSeen = 0.0;          ///< The state's PCG iteration total after the last block.
   double uploadedTolerance = -1.0;           ///< The inner tolerance in the state (-1: none yet).
-  std::map<int, std::unique_ptr<Sequence>> resumes;  ///< Resume-only recordings by dispatch count.
+  /// Resume-only recordings by over-relaxation and dispatch count.
+  std::map<std::pair<double, int>, std::unique_ptr<Sequence>> resumes;
   DeviceVectors q, x, xTilde, rhs, Ctw, r, preconditioned, p, Kp, Px, Cty, Ctdy;  // n x k
   DeviceVectors lower, upper, y, yPrevious, z, zTilde, w, Cx, dy;               // m x k
   /// The iterate at the start of the last multi-dispatch block's first capped iteration (or of
