@@ -34,27 +34,21 @@ void AdmmKernels::recordPolish() {
   p.begin.end();
   // With z = b the ADMM's right-hand side is the refinement's:
   //   sigma x - q + C^T (rho diag(active) b - lambda).
-  p.solve.begin();
-  recordRightHandSide(p.solve);
-  la.copy(p.solve, w.x, w.xTilde);
-  recordInnerSolve(p.solve, cap, SolveTarget::WarmStart, settings_.linearSolver.relativeTolerance);
-  p.solve.end();
   // A solve that needs more continues where it stopped, not restarted: a PCG restarted
-  // every few dozen iterations converges far slower on the stiff K_A.
-  p.resume.begin();
-  recordInnerSolve(p.resume, kPolishResumeIterations, SolveTarget::Continuation,
-                   settings_.linearSolver.relativeTolerance, cap % 2 == 1);
-  p.resume.end();
-  // The same to kPolishSolveTolerance ||r0||: the refinements with momentum.
-  p.looseSolve.begin();
-  recordRightHandSide(p.looseSolve);
-  la.copy(p.looseSolve, w.x, w.xTilde);
-  recordInnerSolve(p.looseSolve, cap, SolveTarget::WarmStart, kPolishSolveTolerance);
-  p.looseSolve.end();
-  p.looseResume.begin();
-  recordInnerSolve(p.looseResume, kPolishResumeIterations, SolveTarget::Continuation, kPolishSolveTolerance,
-                   cap % 2 == 1);
-  p.looseResume.end();
+  // every few dozen iterations converges far slower on the stiff K_A. Plain refinements
+  // solve to the inner solves' tolerance, those with momentum to kPolishSolveTolerance.
+  const auto recordSolve = [&](Sequence& solve, Sequence& resume, double tolerance) {
+    solve.begin();
+    recordRightHandSide(solve);
+    la.copy(solve, w.x, w.xTilde);
+    recordInnerSolve(solve, cap, SolveTarget::WarmStart, tolerance);
+    solve.end();
+    resume.begin();
+    recordInnerSolve(resume, kPolishResumeIterations, SolveTarget::Continuation, tolerance, cap % 2 == 1);
+    resume.end();
+  };
+  recordSolve(p.solve, p.resume, settings_.linearSolver.relativeTolerance);
+  recordSolve(p.looseSolve, p.looseResume, kPolishSolveTolerance);
   // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
   // lambda reaches it).
   p.update.begin();
