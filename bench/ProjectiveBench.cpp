@@ -86,6 +86,39 @@ void BM_RigidLocalStep(benchmark::State& state, BackendChoice choice, RigidLocal
   plano::bench::setFaceCounters(state, p.mesh);
 }
 
+/// A global step's inner-solve iterations split by what they served, from its ADMM's
+/// convergence checks (AdmmSettings::onCheck): those of every ADMM solve, and of the last
+/// solve's iterations at its final rho (after its last rho change: on an iterative backend
+/// the stiffest, dearest solves). The step's other inner iterations are its polish's or its
+/// direct equality solve's.
+class InnerSolveSplit {
+ public:
+  void observe(const plano::compute::AdmmCheck& check) {
+    if (check.iterations <= iterations_) {  // a new solve (the next eps attempt)
+      admm_ += solveLinear_;
+      solveLinear_ = 0;
+      iterations_ = 0;
+    }
+    // A check reports the rho of the iterations before it; a change happens after it.
+    if (iterations_ == 0 || check.rho != finalRho_) {
+      linearBeforeFinalRho_ = solveLinear_;
+      finalRho_ = check.rho;
+    }
+    solveLinear_ = check.linearIterations;
+    iterations_ = check.iterations;
+  }
+  long admm() const { return admm_ + solveLinear_; }
+  long atFinalRho() const { return solveLinear_ - linearBeforeFinalRho_; }
+  double finalRho() const { return finalRho_; }
+
+ private:
+  long admm_ = 0;
+  long solveLinear_ = 0;
+  long linearBeforeFinalRho_ = 0;
+  int iterations_ = 0;
+  double finalRho_ = 0.0;
+};
+
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:
 /// a global step that needs real ADMM work.
 void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
@@ -106,11 +139,14 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   plano::projective::GlobalStepSettings settings;
   settings.epsilonStart = plano::projective::EpsilonStart::ExactFirst;
   settings.qp.preconditioner = preconditioner;
+  InnerSolveSplit split;
+  settings.qp.onCheck = [&split](const plano::compute::AdmmCheck& check) { split.observe(check); };
   plano::projective::GlobalStep global(*backend, space, fixed, settings);
   plano::projective::FaceMaps result;
   plano::projective::GlobalStepInfo info;
   memory.markLoopStart();
   for (auto _ : state) {
+    split = InnerSolveSplit();
     info = global.solve(targets, at, result);
     benchmark::DoNotOptimize(result.maps.data());
   }
@@ -118,6 +154,13 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   state.counters["admm_iterations"] = info.admmIterations;
   state.counters["factorizations"] = info.factorizations;
   state.counters["linear_iterations"] = static_cast<double>(info.linearIterations);
+  // Where the inner iterations went (InnerSolveSplit): the ADMM's, those of its last solve
+  // at its final rho (admm_final_rho, of the inequality rows; equality rows take 1e3 times
+  // it), and the polish's (or the direct equality solve's).
+  state.counters["admm_linear_iterations"] = static_cast<double>(split.admm());
+  state.counters["final_rho_linear_iterations"] = static_cast<double>(split.atFinalRho());
+  state.counters["admm_final_rho"] = split.finalRho();
+  state.counters["polish_linear_iterations"] = static_cast<double>(info.linearIterations - split.admm());
 }
 
 /// One as-rigid-as-possible iteration: fixed row, corner handle lifted.

@@ -411,6 +411,14 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
     return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;
   };
 
+  // The caller's progress report (AdmmSettings::onCheck) of the check just made.
+  auto reportCheck = [&]() {
+    if (settings_.onCheck) {
+      settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_,
+                         s.linearIterations});
+    }
+  };
+
   // OSQP's primal infeasibility certificate from the last dual step dy: for d = dy/||dy||,
   // C^T d ~ 0 and u^T max(d, 0) + l^T min(d, 0) < 0. Both are positively homogeneous, so
   // the kernels measure dy and the normalization happens here.
@@ -523,9 +531,7 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
       }
       if (next < regularCheck) {
         if (converged(false)) {
-          if (settings_.onCheck) {
-            settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
-          }
+          reportCheck();
           info.status = AdmmStatus::Solved;
           break;
         }
@@ -543,9 +549,7 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
                             withinABlock(dualAtCheck, info.dualResidual, dualTolerance);
       primalAtCheck = info.primalResidual;
       dualAtCheck = info.dualResidual;
-      if (settings_.onCheck) {
-        settings_.onCheck({info.iterations, info.primalResidual, primalTolerance, info.dualResidual, dualTolerance, rho_});
-      }
+      reportCheck();
       if (done) {
         info.status = AdmmStatus::Solved;
         break;

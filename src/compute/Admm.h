@@ -48,6 +48,9 @@ struct AdmmCheck {
   double dualResidual = 0.0;     ///< max ||P x + q + C^T y||_inf over the columns.
   double dualTolerance = 0.0;
   double rho = 0.0;              ///< Of the inequality rows.
+  /// Iterations of the inner solves with K since this solve began (AdmmInfo::linearIterations
+  /// so far): PCG iterations on an iterative backend, one per solve where K is factored.
+  long linearIterations = 0;
 };
 
 struct AdmmSettings {

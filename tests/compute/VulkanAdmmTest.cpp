@@ -1264,6 +1264,24 @@ TEST_F(VulkanAdmm, ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor)
   EXPECT_LT((x - exact).cwiseAbs().maxCoeff(), 1e-10);
 }
 
+TEST_F(VulkanAdmm, ConvergenceChecksReportThePcgIterationsOfTheInnerSolvesSoFar) {
+  // What a progress report or a benchmark splits a device solve's cost by (the inner solves
+  // before and after a rho change): the counts at the checks are those of the solve's info.
+  const BoxQp qp = randomBoxQp(60, 45, 2);
+  compute::AdmmSettings settings = tightSettings();
+  std::vector<compute::AdmmCheck> checks;
+  settings.onCheck = [&](const compute::AdmmCheck& check) { checks.push_back(check); };
+  const AdmmRun run = runAdmm(context(), qp, settings, kRecordings[0]);
+  ASSERT_EQ(run.info.status, compute::AdmmStatus::Solved);
+  ASSERT_GE(checks.size(), 2u);
+  for (std::size_t i = 1; i < checks.size(); ++i) {
+    EXPECT_GT(checks[i].linearIterations, checks[i - 1].linearIterations) << "check " << i;
+  }
+  EXPECT_GT(checks.front().linearIterations, checks.front().iterations) << "PCG: several iterations per solve";
+  EXPECT_EQ(checks.back().iterations, run.info.iterations);
+  EXPECT_EQ(checks.back().linearIterations, run.info.linearIterations);
+}
+
 TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgIterations) {
   // 144 faces (two multigrid levels), the exact (eps = 0) attempt's QP: every row an
   // equality row, the default inner tolerance, the multi-dispatch recording. Near

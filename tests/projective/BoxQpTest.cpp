@@ -373,10 +373,12 @@ TEST(BoxQp, TheAdmmReportsEachConvergenceCheckToItsCallback) {
     EXPECT_GT(checks[i].primalTolerance, 0.0);
     EXPECT_GT(checks[i].dualTolerance, 0.0);
     EXPECT_GT(checks[i].rho, 0.0);
+    EXPECT_EQ(checks[i].linearIterations, checks[i].iterations) << "one factored solve per ADMM iteration";
   }
   // The last check is the converged one, with the residuals the solve reports.
   EXPECT_EQ(checks.back().primalResidual, info.primalResidual);
   EXPECT_EQ(checks.back().dualResidual, info.dualResidual);
+  EXPECT_EQ(checks.back().linearIterations, info.linearIterations);
   EXPECT_LE(checks.back().primalResidual, checks.back().primalTolerance);
   EXPECT_LE(checks.back().dualResidual, checks.back().dualTolerance);
 }

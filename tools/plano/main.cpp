@@ -70,7 +70,8 @@ std::function<void(const compute::AdmmCheck&)> admmHeartbeat(const GlobalOptions
     std::ostringstream line;
     line << std::setprecision(3) << "  ADMM iteration " << check.iterations << ": primal residual "
          << check.primalResidual << " (tolerance " << check.primalTolerance << "), dual residual "
-         << check.dualResidual << " (tolerance " << check.dualTolerance << ")";
+         << check.dualResidual << " (tolerance " << check.dualTolerance << "), rho " << check.rho << ", "
+         << check.linearIterations << " inner solve iterations";
     std::cerr << line.str() << std::endl;
   };
 }
