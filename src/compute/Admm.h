@@ -31,11 +31,9 @@ enum class AdmmPreconditioner {
   /// An aggregation V-cycle over those blocks (compute/BlockMultigrid.h): several times
   /// fewer PCG iterations on the global step's stiff matrices, each iteration dearer.
   Multigrid,
-  /// Multigrid when K has more blocks than the cycle's coarsest level
-  /// (BlockMultigridSettings::coarsestBlocks), where the cycle has coarse levels at all,
-  /// and its coarsening does not stall on a large coarsest level; block-Jacobi otherwise
-  /// (small problems, whose many cheap iterations cost less) and in a single-workgroup
-  /// recording. A K of few blocks (vk::AdmmKernels::kMaxWholeInverseBlocks) keeps the
+  /// Multigrid where its coarsening does not stall on a large coarsest level, block-Jacobi
+  /// otherwise and in a single-workgroup recording (which has no cycle). A K of few blocks
+  /// (vk::AdmmKernels::kMaxWholeInverseBlocks, the smallest problems included) keeps the
   /// cycle's dense coarsest level alone: K's inverse, an exact preconditioner.
   Automatic,
 };

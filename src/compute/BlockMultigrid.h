@@ -9,7 +9,8 @@
 // are constant over small groups of faces is close to that near-null space: as the PCG
 // preconditioner, a V-cycle over such groups needs 9-15x fewer iterations on 1k-4k-face
 // global-step matrices, and the cut grows with the mesh (BlockMultigridTest). The device's
-// cycle (vk::Multigrid) preconditions the global step's ADMM above 64 faces.
+// cycle (vk::Multigrid) preconditions the global step's ADMM above 128 faces (below, its
+// coarsest level alone: K's dense inverse).
 //
 // Construction (plain aggregation AMG, block version): the unknowns come in blocks of b
 // rows (a face's map entries); each level pairs every block with its most strongly coupled

@@ -66,7 +66,7 @@ struct GlobalStepSettings {
   /// geometrically (n = 2 and growth 10: 10^(1/3) and 10^(2/3) times the failed eps).
   /// 0: the paper's schedule alone.
   int intermediateAttempts = 0;
-  /// The QP's settings. On an iterative backend the inner solves with K of more than 64
+  /// The QP's settings. On an iterative backend the inner solves with K of more than 128
   /// faces use the aggregation multigrid over faces (compute/BlockMultigrid.h): several
   /// times fewer PCG iterations than face blocks, and the host's ADMM iteration kept where
   /// those drift. Up to 128 faces the multigrid is K's dense inverse alone (one PCG

@@ -1314,17 +1314,41 @@ TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgItera
   EXPECT_GE(blocks.info.iterations, multigrid.info.iterations);
 }
 
-TEST_F(VulkanAdmm, AutomaticPreconditionerIsMultigridAboveTheCoarsestLevelOnly) {
-  for (Index side : {8, 12}) {  // 64 faces: one level, no coarsening; 144: two levels
+TEST_F(VulkanAdmm, AutomaticPreconditionerIsKsWholeInverseUpTo128FacesAndTheCycleAbove) {
+  // 64 faces (the cycle's coarsest target: once face blocks in the single-workgroup
+  // recording) and 100: K's whole inverse, one level; 144: the two-level cycle. The
+  // single-workgroup recording has no cycle and keeps face blocks.
+  for (const auto& [side, levels] : {std::pair<Index, int>{8, 1}, {10, 1}, {12, 2}}) {
+    SCOPED_TRACE(side * side);
     RecordingBackend recorder;
     ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(side, recorder));
     const compute::AdmmSettings settings = recorder.settingsUsed;
     ASSERT_EQ(settings.preconditioner, compute::AdmmPreconditioner::Automatic);
     const vk::AdmmKernels automatic(context(), recorder.qp.P, recorder.qp.C, settings);
-    EXPECT_EQ(automatic.multigrid(), side == 12) << side * side << " faces";
+    EXPECT_TRUE(automatic.multigrid());
+    EXPECT_EQ(automatic.multigridLevels(), levels);
     const vk::AdmmKernels single(context(), recorder.qp.P, recorder.qp.C, settings, vk::AdmmRecording::SingleWorkgroup);
     EXPECT_FALSE(single.multigrid()) << "the single-workgroup kernel has no cycle";
   }
+}
+
+TEST_F(VulkanAdmm, A64FaceStepWithKsWholeInverseKeepsTheHostIterationInAboutOnePcgIterationPerSolve) {
+  // Measured (BM_GlobalStep/vulkan/64, lavapipe): 3 668 PCG iterations with face blocks in
+  // one workgroup, 41 with the whole inverse.
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
+  compute::CpuBackend cpu;
+  const compute::AdmmSettings settings = recorder.settingsUsed;
+  const AdmmRun host = runAdmm(cpu, recorder.qp, settings);
+  ASSERT_EQ(host.info.status, compute::AdmmStatus::Solved);
+  const AdmmRun exact = runAdmm(context(), recorder.qp, settings, kRecordings[0]);
+  expectAgreement(exact, host, settings, 1e-6);
+  EXPECT_EQ(exact.info.iterations, host.info.iterations);
+  EXPECT_LE(exact.info.linearIterations, 3L * exact.info.iterations) << "the preconditioner is K's inverse";
+  compute::AdmmSettings blocks = settings;
+  blocks.preconditioner = compute::AdmmPreconditioner::BlockJacobi;
+  const AdmmRun faceBlocks = runAdmm(context(), recorder.qp, blocks, kRecordings[0]);
+  EXPECT_GT(faceBlocks.info.linearIterations, 10L * exact.info.linearIterations);
 }
 
 TEST_F(VulkanAdmm, AutomaticMultigridInvertsAKSmallEnoughWholeAndSolvesInAboutOnePcgIterationPerSolve) {

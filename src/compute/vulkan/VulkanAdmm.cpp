@@ -196,11 +196,11 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
   algebra_.gatherSum(valuesUpdate_, *transpose_, devC_.values(), devCt_.values());
   valuesUpdate_.end();
   const compute::BlockMultigridSettings multigridSettings{static_cast<int>(block_)};
-  const bool multigrid =
-      settings_.preconditioner == compute::AdmmPreconditioner::Multigrid ||
-      (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
-       recording_ != AdmmRecording::SingleWorkgroup &&
-       static_cast<Index>(n_ / block_) > multigridSettings.coarsestBlocks);
+  // Automatic: the cycle, or K's whole inverse where K is small (below); both need the
+  // multi-dispatch recording, so an explicit single-workgroup one keeps face blocks.
+  const bool multigrid = settings_.preconditioner == compute::AdmmPreconditioner::Multigrid ||
+                         (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
+                          recording_ != AdmmRecording::SingleWorkgroup);
   if (settings_.preconditioner == compute::AdmmPreconditioner::Multigrid &&
       recording_ == AdmmRecording::SingleWorkgroup) {
     throwUsage("ADMM: the multigrid preconditioner runs only in the multi-dispatch recording");
@@ -216,7 +216,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // Automatic, and K small enough: its dense inverse alone, an exact preconditioner (one
     // PCG iteration per solve). A V-cycle over 4-face aggregates is far weaker there: the
     // cube's 96-face PQ level took ~100 PCG iterations per solve with it (307 s on
-    // lavapipe) against one (48 s). Not up to the coarsest level's limit: the inversion at
+    // lavapipe) against one (48 s). So were face blocks on K of at most 64 faces (run in
+    // the single-workgroup recording before): the 64-face exact step of BM_GlobalStep/vulkan
+    // took 3 668 PCG iterations with them and takes 41 (lavapipe 1.9 -> 1.5 s). Not up to the coarsest level's limit: the inversion at
     // each rho update is cubic in K's rows, and at 256 faces (1 024 rows) it cost more than
     // the iterations it saved (a deformation's global step, 30 ADMM iterations: 104 s with
     // 60 PCG iterations, 21.8 s with the two-level cycle's 3 961).
