@@ -94,7 +94,9 @@ void BM_RigidLocalStep(benchmark::State& state, BackendChoice choice, RigidLocal
 class InnerSolveSplit {
  public:
   void observe(const plano::compute::AdmmCheck& check) {
-    if (check.iterations <= iterations_) {  // a new solve (the next eps attempt)
+    // A new solve (the next eps attempt): every solve's first check comes at its
+    // checkInterval-th iteration, and the counts only grow within a solve.
+    if (check.iterations <= iterations_) {
       admm_ += solveLinear_;
       solveLinear_ = 0;
       iterations_ = 0;
