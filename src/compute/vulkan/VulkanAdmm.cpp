@@ -218,9 +218,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // cube's 96-face PQ level took ~100 PCG iterations per solve with it (307 s on
     // lavapipe) against one (48 s). So were face blocks on K of at most 64 faces (run in
     // the single-workgroup recording before): the 64-face exact step of BM_GlobalStep/vulkan
-    // took 3 668 PCG iterations with them and takes 41 (lavapipe 1.9 -> 1.5 s). Not up to the coarsest level's limit: the inversion at
-    // each rho update is cubic in K's rows, and at 256 faces (1 024 rows) it cost more than
-    // the iterations it saved (a deformation's global step, 30 ADMM iterations: 104 s with
+    // took 3 668 PCG iterations with them and takes 41 (lavapipe 1.9 -> 1.5 s). Not up to
+    // the coarsest level's limit: the inversion at each rho update is cubic in K's rows,
+    // and at 256 faces (1 024 rows) it cost more than the iterations it saved (a deformation's global step, 30 ADMM iterations: 104 s with
     // 60 PCG iterations, 21.8 s with the two-level cycle's 3 961).
     compute::BlockMultigridSettings aggregationSettings = multigridSettings;
     if (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
