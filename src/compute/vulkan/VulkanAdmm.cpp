@@ -220,8 +220,9 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // the single-workgroup recording before): the 64-face exact step of BM_GlobalStep/vulkan
     // took 3 668 PCG iterations with them and takes 41 (lavapipe 1.9 -> 1.5 s). Not up to
     // the coarsest level's limit: the inversion at each rho update is cubic in K's rows,
-    // and at 256 faces (1 024 rows) it cost more than the iterations it saved (a deformation's global step, 30 ADMM iterations: 104 s with
-    // 60 PCG iterations, 21.8 s with the two-level cycle's 3 961).
+    // and at 256 faces (1 024 rows) it cost more than the iterations it saved (a
+    // deformation's global step, 30 ADMM iterations: 104 s with 60 PCG iterations, 21.8 s
+    // with the two-level cycle's 3 961).
     compute::BlockMultigridSettings aggregationSettings = multigridSettings;
     if (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
         static_cast<Index>(n_ / block_) <= kMaxWholeInverseBlocks) {
