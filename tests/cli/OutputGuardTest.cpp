@@ -2,8 +2,17 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
+#include <fcntl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
 
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "support/TestMeshes.h"
 
@@ -88,6 +97,133 @@ TEST_F(OutputGuard, ACommandsWrittenFilesMustGoToExistingFoldersAndSpareItsInput
   // Two written files in one.
   EXPECT_NE(writing({{"--output", out}, {"--primal", path("sub/../out.obj")}}).find("is also the file of --output"),
             std::string::npos);
+}
+
+TEST_F(OutputGuard, MeshOutputsNeedAKnownFormatAndAFileNotAFolder) {
+  // Checked after the computation before: subdivide --levels 4 -o out.xyz computed for
+  // seconds, then failed; -o naming a folder the same.
+  std::filesystem::create_directory(dir_ / "folder.obj");
+  EXPECT_NE(refusal(reading(path("in.obj"), path("out.xyz"))).find("--output " + path("out.xyz") +
+                                                                   ": unknown mesh format '.xyz'"),
+            std::string::npos);
+  EXPECT_NE(refusal(reading(path("in.obj"), path("folder.obj"))).find("is a folder"), std::string::npos);
+  EXPECT_NE(refusal({{path("in.obj")}, {{"--output", path("out.obj")}, {"--report", path("folder.obj")}}, false, true})
+                .find("is a folder"),
+            std::string::npos);
+  // A report may have any name.
+  EXPECT_EQ(refusal({{path("in.obj")}, {{"--output", path("out.obj")}, {"--report", path("r.txt")}}, false, true}), "");
+}
+
+TEST_F(OutputGuard, AnOptionGivenEmptyIsRefusedNotIgnored) {
+  EXPECT_EQ(refusal({{path("in.obj")}, {{"--output", path("out.obj")}, {"--report", "", true}}, false, true}),
+            "--report: the path is empty");
+  EXPECT_EQ(refusal({{path("in.obj")}, {{"--output", "", true}}, false, true}), "--output: the path is empty");
+}
+
+TEST_F(OutputGuard, SymbolicLinksResolveToTheFileTheyName) {
+  std::filesystem::create_symlink("real.json", path("link.json"));  // dangling until written
+  std::filesystem::create_symlink(path("link.json"), path("link2.json"));
+  const OutputTarget target = resolveOutput(path("link2.json"));
+  EXPECT_EQ(target.path, dir_ / "real.json");
+  EXPECT_FALSE(target.stream);
+}
+
+TEST_F(OutputGuard, FifosAndCharacterDevicesAreStreamsSocketsAreRefused) {
+  ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0644), 0);
+  EXPECT_TRUE(resolveOutput(path("fifo")).stream);
+  EXPECT_TRUE(resolveOutput("/dev/null").stream);
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  const std::string socketPath = path("socket");
+  ASSERT_LT(socketPath.size(), sizeof address.sun_path);
+  std::copy(socketPath.begin(), socketPath.end(), address.sun_path);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address), 0);
+  ::close(fd);
+  EXPECT_NE(refusal({{path("in.obj")}, {{"--report", socketPath}}, false, true}).find("is a socket"), std::string::npos);
+}
+
+std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Names in `dir` that start with '.': the temporary files of OutputFiles.
+std::vector<std::string> hiddenFiles(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().filename().string().front() == '.') names.push_back(entry.path().filename().string());
+  }
+  return names;
+}
+
+TEST_F(OutputGuard, FilesOfOneRunAreWrittenAllOrNone) {
+  // dual -o d.obj --primal P: d.obj was replaced before P failed.
+  std::ofstream(dir_ / "first.obj") << "KEEP\n";
+  OutputFiles files;
+  files.add(path("first.obj"), "new\n");
+  files.add(path("missing/second.obj"), "new\n");  // its temporary file cannot be created
+  EXPECT_THROW(files.commit(), Error);
+  EXPECT_EQ(slurp(dir_ / "first.obj"), "KEEP\n");
+  EXPECT_TRUE(hiddenFiles(dir_.path()).empty());
+
+  OutputFiles both;
+  both.add(path("first.obj"), "one\n");
+  both.add(path("second.json"), "two\n");
+  both.commit();
+  EXPECT_EQ(slurp(dir_ / "first.obj"), "one\n");
+  EXPECT_EQ(slurp(dir_ / "second.json"), "two\n");
+}
+
+TEST_F(OutputGuard, WritingThroughALinkKeepsTheLink) {
+  std::ofstream(dir_ / "real.json") << "old\n";
+  std::filesystem::create_symlink("real.json", path("link.json"));
+  OutputFiles files;
+  files.add(path("link.json"), "new\n");
+  files.commit();
+  EXPECT_TRUE(std::filesystem::is_symlink(dir_ / "link.json"));
+  EXPECT_EQ(slurp(dir_ / "real.json"), "new\n");
+}
+
+TEST_F(OutputGuard, AFifoIsWrittenToNotReplaced) {
+  ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0644), 0);
+  std::string received;
+  std::thread reader([&] { received = slurp(dir_ / "fifo"); });
+  OutputFiles files;
+  files.add(path("fifo"), "through the pipe\n");
+  bool written = false;
+  EXPECT_NO_THROW({
+    files.commit();
+    written = true;
+  });
+  if (!written) {  // No writer came: let the reader go.
+    const int fd = ::open(path("fifo").c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) ::close(fd);
+  }
+  reader.join();
+  EXPECT_EQ(received, "through the pipe\n");
+  struct stat info {};
+  ASSERT_EQ(::lstat(path("fifo").c_str(), &info), 0);
+  EXPECT_TRUE(S_ISFIFO(info.st_mode));
+}
+
+TEST_F(OutputGuard, InterruptibleFilesAreNotWrittenAfterCtrlC) {
+  std::ofstream(dir_ / "out.obj") << "KEEP\n";
+  requestCancellation();
+  OutputFiles files(/*interruptible=*/true);
+  files.add(path("out.obj"), "new\n");
+  EXPECT_THROW(files.commit(), Interrupted);
+  // The report of an interrupted run is written all the same.
+  OutputFiles report;
+  report.add(path("r.json"), "{}\n");
+  EXPECT_NO_THROW(report.commit());
+  clearCancellation();
+  EXPECT_EQ(slurp(dir_ / "out.obj"), "KEEP\n");
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "r.json"));
+  EXPECT_TRUE(hiddenFiles(dir_.path()).empty());
 }
 
 }  // namespace

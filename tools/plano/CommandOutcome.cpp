@@ -29,13 +29,18 @@ void finishCommand(const std::string& command, CommandOutcome outcome, bool keep
   const bool succeeded = outcome.failure.empty();
   // Non-finite coordinates cannot be written to any mesh format, partial or not.
   const bool write = (succeeded || keepPartial) && finite;
+  // The meshes and the report are written together: a file that cannot be written leaves
+  // the others as they were (dual's -o is not replaced when --primal fails).
+  OutputFiles files(/*interruptible=*/true);
   if (write) {
-    for (const MeshOutput& output : outputs) writeMesh(output.path, *output.mesh);
+    for (const MeshOutput& output : outputs) {
+      files.add(output.path, formatMesh(*output.mesh, meshFormatFromPath(output.path)));
+    }
   }
   report["status"] = outcome.status;
   if (!succeeded) report["reason"] = outcome.failure;
   report["output_written"] = write;
-  writeReport(reportPath, report);
+  writeReport(reportPath, report, std::move(files));
   if (succeeded) return;
   std::string written;
   if (write) {

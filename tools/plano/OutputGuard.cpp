@@ -1,11 +1,20 @@
 #include "plano/OutputGuard.h"
 
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <random>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
+#include "mesh/MeshIO.h"
 
 namespace plano::cli {
 namespace {
@@ -26,9 +35,9 @@ bool sameInode(const std::string& a, const std::string& b) {
 }
 
 /// The folder a file is written into must exist and be writable (the atomic write creates
-/// a temporary file there).
-void checkOutputFolder(const std::string& path, const std::string& what) {
-  const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+/// a temporary file there). `target` is where `path` resolves.
+void checkOutputFolder(const std::string& path, const std::filesystem::path& target, const std::string& what) {
+  const std::filesystem::path folder = std::filesystem::absolute(target).parent_path();
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
     throwUsage(what + " " + path + ": the folder " + folder.string() + " does not exist");
@@ -37,6 +46,9 @@ void checkOutputFolder(const std::string& path, const std::string& what) {
     throwUsage(what + " " + path + ": the folder " + folder.string() + " is not writable");
   }
 }
+
+/// The options whose files are meshes, in the format their extension names.
+bool writesMesh(const std::string& option) { return option == "--output" || option == "--primal"; }
 
 /// The same file, by path or by inode; empty paths never are.
 bool sameFile(const std::string& a, const std::string& b) {
@@ -54,9 +66,11 @@ std::string CommandPaths::report() const {
 
 void checkCommandPaths(const CommandPaths& paths) {
   for (std::size_t i = 0; i < paths.outputs.size(); ++i) {
-    const auto& [option, path] = paths.outputs[i];
-    if (path.empty()) continue;
-    checkOutputFolder(path, option);
+    const auto& [option, path, given] = paths.outputs[i];
+    if (path.empty()) {
+      if (given) throwUsage(option + ": the path is empty");
+      continue;
+    }
     for (std::size_t k = 0; k < paths.inputs.size(); ++k) {
       const bool resultOverMesh = i == 0 && k == 0;
       if ((resultOverMesh && paths.inPlace) || !sameFile(paths.inputs[k], path)) continue;
@@ -70,6 +84,170 @@ void checkCommandPaths(const CommandPaths& paths) {
                    ": give them different files");
       }
     }
+    if (writesMesh(option)) {
+      try {
+        meshFormatFromPath(path);
+      } catch (const Error& e) {
+        throwUsage(option + " " + e.what());
+      }
+    }
+    const OutputTarget target = resolveOutput(path);
+    if (target.stream) {
+      if (::access(target.path.c_str(), W_OK) != 0) throwUsage(option + " " + path + ": not writable");
+    } else {
+      checkOutputFolder(path, target.path, option);
+    }
+  }
+}
+
+OutputTarget resolveOutput(const std::string& path) {
+  // Links are followed by hand: the standard library's canonical forms do not follow a link
+  // whose file does not exist yet, and writing through such a link creates that file.
+  std::filesystem::path target = std::filesystem::absolute(path);
+  struct stat info {};
+  for (int links = 0; ::lstat(target.c_str(), &info) == 0 && S_ISLNK(info.st_mode); ++links) {
+    if (links == 40) throwUsage(path + ": too many levels of symbolic links");
+    std::error_code ec;
+    const std::filesystem::path next = std::filesystem::read_symlink(target, ec);
+    if (ec) throwUsage(path + ": cannot read the symbolic link " + target.string() + " (" + ec.message() + ")");
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  if (::lstat(target.c_str(), &info) != 0 || S_ISREG(info.st_mode)) return {target, false};
+  if (S_ISFIFO(info.st_mode) || S_ISCHR(info.st_mode)) return {target, true};
+  const char* kind = S_ISDIR(info.st_mode)    ? "a folder"
+                     : S_ISSOCK(info.st_mode) ? "a socket"
+                     : S_ISBLK(info.st_mode)  ? "a block device"
+                                              : "not a regular file";
+  throwUsage(path + (target == std::filesystem::absolute(path) ? "" : " (" + target.string() + ")") + " is " + kind +
+             ": give a file to write");
+}
+
+namespace {
+
+/// Blocks SIGINT and SIGTERM in this thread while it lives. The tool's first Ctrl-C only
+/// sets a flag, but a second one kills the process: deferred, it cannot leave temporary
+/// files behind or some targets replaced and others not. poll() lets a pending signal in
+/// (its handler sets the flag) between two pieces of work.
+class SignalsDeferred {
+ public:
+  SignalsDeferred() {
+    sigemptyset(&signals_);
+    sigaddset(&signals_, SIGINT);
+    sigaddset(&signals_, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals_, &previous_);
+  }
+  ~SignalsDeferred() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
+  SignalsDeferred(const SignalsDeferred&) = delete;
+  SignalsDeferred& operator=(const SignalsDeferred&) = delete;
+
+  void poll() {
+    pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
+    pthread_sigmask(SIG_BLOCK, &signals_, nullptr);
+  }
+
+ private:
+  sigset_t signals_;
+  sigset_t previous_;
+};
+
+/// Write all of `content` to `fd`, in pieces between which `between` runs; false with errno
+/// set when a write fails.
+template <typename Between>
+bool writeAll(int fd, const std::string& content, Between between) {
+  constexpr std::size_t kPiece = std::size_t{16} << 20;
+  const char* data = content.data();
+  std::size_t left = content.size();
+  while (left > 0) {
+    between();
+    const ssize_t written = ::write(fd, data, std::min(left, kPiece));
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    data += written;
+    left -= static_cast<std::size_t>(written);
+  }
+  return true;
+}
+
+std::filesystem::path temporaryNextTo(const std::filesystem::path& target) {
+  std::random_device random;
+  std::string name = ".";
+  name += target.filename().string();
+  name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(random());
+  return target.parent_path() / name;
+}
+
+}  // namespace
+
+void OutputFiles::add(std::string path, std::string content) { files_.push_back({std::move(path), std::move(content)}); }
+
+void OutputFiles::commit() {
+  std::vector<OutputTarget> targets;
+  for (const File& file : files_) targets.push_back(resolveOutput(file.path));
+  std::vector<std::filesystem::path> temporaries(files_.size());
+  {
+    SignalsDeferred deferred;
+    const auto removeTemporaries = [&] {
+      std::error_code ignored;
+      for (const auto& temp : temporaries) {
+        if (!temp.empty()) std::filesystem::remove(temp, ignored);
+      }
+    };
+    const auto between = [&] {
+      if (!interruptible_) return;
+      deferred.poll();
+      if (cancellationRequested()) {
+        removeTemporaries();
+        throw Interrupted("stopped during writing the results");
+      }
+    };
+    for (std::size_t i = 0; i < files_.size(); ++i) {
+      if (targets[i].stream) continue;
+      const std::filesystem::path temp = temporaryNextTo(targets[i].path);
+      const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+      if (fd < 0) {
+        const std::string why = std::strerror(errno);
+        removeTemporaries();
+        throwBadInput(files_[i].path + ": cannot write (" + why + ")");
+      }
+      temporaries[i] = temp;
+      // On disk before the rename, so that a crash cannot leave an empty file in place of the old one.
+      if (!writeAll(fd, files_[i].content, between) || ::fsync(fd) != 0) {
+        const std::string why = std::strerror(errno);
+        ::close(fd);
+        removeTemporaries();
+        throwBadInput(files_[i].path + ": write failed (" + why + ")");
+      }
+      if (::close(fd) != 0) {
+        const std::string why = std::strerror(errno);
+        removeTemporaries();
+        throwBadInput(files_[i].path + ": write failed (" + why + ")");
+      }
+    }
+    between();
+    for (std::size_t i = 0; i < files_.size(); ++i) {
+      if (temporaries[i].empty()) continue;
+      std::error_code ec;
+      std::filesystem::rename(temporaries[i], targets[i].path, ec);
+      if (ec) {
+        removeTemporaries();
+        throwBadInput(files_[i].path + ": cannot replace the file: " + ec.message());
+      }
+      temporaries[i].clear();
+    }
+  }
+  // Streams last, with signals let in: opening a FIFO waits for its reader, and Ctrl-C must
+  // still end a run that waits for one that never comes.
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    if (!targets[i].stream) continue;
+    const int fd = ::open(targets[i].path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0 || !writeAll(fd, files_[i].content, [] {})) {
+      const std::string why = std::strerror(errno);
+      if (fd >= 0) ::close(fd);
+      throwBadInput(files_[i].path + ": write failed (" + why + ")");
+    }
+    ::close(fd);
   }
 }
 

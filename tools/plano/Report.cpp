@@ -71,10 +71,14 @@ const char* failureStatus(ErrorKind kind) {
   return "error";
 }
 
-void writeReport(const std::string& path, const nlohmann::json& report) {
-  if (path.empty()) return;
-  writeFileAtomically(path, report.dump(2) + "\n");
-  ++written;
+std::string reportText(const nlohmann::json& report) {
+  return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+void writeReport(const std::string& path, const nlohmann::json& report, OutputFiles with) {
+  if (!path.empty()) with.add(path, reportText(report));
+  with.commit();
+  if (!path.empty()) ++written;
 }
 
 std::size_t reportsWritten() { return written; }

@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "mesh/Planarity.h"
 #include "mesh/PolygonMesh.h"
+#include "plano/OutputGuard.h"
 #include "projective/GlobalStep.h"
 
 namespace plano::cli {
@@ -32,8 +33,13 @@ void addTransferList(nlohmann::json& entry, const std::string& key,
 nlohmann::json baseReport(const std::string& command, const std::string& backend, const PolygonMesh& mesh,
                           const PlanarityStats& planarity, double seconds);
 
-/// Write a report atomically (pretty-printed); no-op for an empty path.
-void writeReport(const std::string& path, const nlohmann::json& report);
+/// The report as pretty-printed JSON text. Bytes that are not UTF-8 (a file name in another
+/// encoding) are replaced by U+FFFD: JSON text must be UTF-8, and nlohmann throws on them.
+std::string reportText(const nlohmann::json& report);
+
+/// Write a report (reportText) together with the run's other files `with` (OutputFiles: all
+/// of them or none); only `with` for an empty path.
+void writeReport(const std::string& path, const nlohmann::json& report, OutputFiles with = OutputFiles{});
 
 /// How many reports writeReport has written in this process. A run that wrote its own
 /// report (more detailed than the failure report) changes it, so the failure report does

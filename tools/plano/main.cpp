@@ -106,7 +106,10 @@ CommandPaths commandPaths(const CLI::App& command) {
   for (const char* name : {"mesh", "topology", "a", "b", "--base", "--constraints", "--fixed", "--faces-file"}) {
     if (const std::string path = given(name); !path.empty()) paths.inputs.push_back(path);
   }
-  for (const char* name : {"--output", "--primal", "--report"}) paths.outputs.push_back({name, given(name)});
+  for (const char* name : {"--output", "--primal", "--report"}) {
+    const CLI::Option* option = command.get_option_no_throw(name);
+    paths.outputs.push_back({name, given(name), option != nullptr && option->count() > 0});
+  }
   const CLI::Option* inPlace = command.get_option_no_throw("--in-place");
   paths.inPlaceOption = inPlace != nullptr;
   paths.inPlace = inPlace != nullptr && inPlace->count() > 0;

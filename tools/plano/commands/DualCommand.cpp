@@ -54,8 +54,6 @@ RunFunction setup(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(o->input);
     const PolygonMesh dual = polarDual(mesh);
-    progress(global, "dual: " + std::to_string(dual.vertexCount()) + " vertices, " + std::to_string(dual.faceCount()) +
-                         " faces -> " + o->output);
     nlohmann::json j;
     PlanarityStats stats = planarityStats(dual);
     nlohmann::json exploration;
@@ -81,8 +79,6 @@ RunFunction setup(CLI::App& app) {
                      {"frequency", shapes.frequencies[o->eigenshape]},
                      {"primal", o->primal},
                      {"primal_max_planarity", stats.max}};
-      std::cout << "explored the dual's " << o->linearSpace.space << " space (dimension " << space.dof.dimension
-                << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     j = baseReport("dual", backendName, o->primal.empty() ? dual : mesh, stats, seconds);
@@ -93,6 +89,11 @@ RunFunction setup(CLI::App& app) {
     std::vector<MeshOutput> outputs{{o->output, &dual}};
     if (!o->primal.empty()) outputs.push_back({o->primal, &primal});
     finishCommand("dual", CommandOutcome{}, o->keepPartial, outputs, j, o->report);
+    // Only now: the files named here are written.
+    if (!exploration.is_null()) {
+      std::cout << "explored the dual's " << o->linearSpace.space << " space (dimension " << exploration["dimension"]
+                << "), primal max planarity " << stats.max << "% -> " << o->primal << "\n";
+    }
     std::cout << "dual of " << o->input << ": " << dual.vertexCount() << " vertices, " << dual.faceCount()
               << " faces -> " << o->output << "\n";
     return 0;

@@ -6,6 +6,7 @@
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
+#include "plano/CommandOutcome.h"
 #include "plano/Report.h"
 
 namespace plano::cli {
@@ -32,12 +33,13 @@ RunFunction setup(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = generate::byName(options->kind, options->n);
     const PlanarityStats stats = planarityStats(mesh);
-    writeMesh(options->output, mesh);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // The mesh and the report together, and neither after Ctrl-C.
+    finishCommand("generate", CommandOutcome{}, false, {{options->output, &mesh}},
+                  baseReport("generate", "cpu", mesh, stats, seconds), options->report);
     progress(global, "generated " + options->kind + ": " + std::to_string(mesh.vertexCount()) + " vertices, " +
                          std::to_string(mesh.faceCount()) + " faces, max planarity " + std::to_string(stats.max) +
                          "% -> " + options->output);
-    writeReport(options->report, baseReport("generate", "cpu", mesh, stats, seconds));
     return 0;
   };
 }

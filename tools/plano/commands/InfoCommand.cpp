@@ -131,7 +131,7 @@ RunFunction setup(CLI::App& app) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const nlohmann::json j = describe(mesh, topology, validation, stats, backend->name(), seconds);
     if (options->json) {
-      std::cout << j.dump(2) << std::endl;
+      std::cout << reportText(j) << std::flush;
     } else {
       printText(j, mesh, options->input);
     }
