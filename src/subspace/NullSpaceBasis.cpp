@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <Eigen/SPQRSupport>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/Memory.h"
 
@@ -22,7 +23,10 @@ Eigen::MatrixXd denseNullSpace(const compute::SparseMatrix& B, double tolerance,
   // values and to return wrong vectors for the full V of a wide matrix.
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(std::max(B.rows(), n), n);
   dense.topRows(B.rows()) = Eigen::MatrixXd(B);
+  // The SVD itself cannot be interrupted: checked before and after it.
+  throwIfCancelled("the null-space basis (before the SVD)");
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(dense, Eigen::ComputeFullV);
+  throwIfCancelled("the null-space basis (after the SVD)");
   const Eigen::VectorXd& s = svd.singularValues();
   const double cut = tolerance * std::max(s.size() ? s[0] : 0.0, 1e-300);
   Eigen::Index r = 0;
@@ -46,14 +50,25 @@ Eigen::MatrixXd sparseNullSpace(const compute::SparseMatrix& B, double tolerance
   for (Eigen::Index j = 0; j < At.outerSize(); ++j) maxColumn = std::max(maxColumn, At.col(j).norm());
   qr.setPivotThreshold(tolerance * std::max(maxColumn, 1e-300));
   qr.cholmodCommon()->print = 0;  // A failure is the Error below, not CHOLMOD's own lines.
+  // SPQR's factorization cannot be interrupted: checked before and after it.
+  throwIfCancelled("the null-space basis (before the sparse QR)");
   qr.compute(At);
+  throwIfCancelled("the null-space basis (after the sparse QR)");
   if (qr.info() != Eigen::Success) throwNumerical("sparse QR of the constraint matrix failed");
   rank = static_cast<Index>(qr.rank());
   requireBasisMemory(n, n - rank, /*atLeast=*/false, memoryLimit);
-  Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(n, n - rank);
-  selector.bottomRows(n - rank).setIdentity();
-  Eigen::MatrixXd N;
-  N = qr.matrixQ() * selector;
+  // The last n - rank columns of Q, formed a block of columns at a time: on a large mesh
+  // applying Q takes as long as the factorization, and a Ctrl-C is looked at between blocks.
+  constexpr Eigen::Index kBlock = 256;
+  const Eigen::Index dimension = n - rank;
+  Eigen::MatrixXd N(n, dimension);
+  for (Eigen::Index first = 0; first < dimension; first += kBlock) {
+    throwIfCancelled("the null-space basis (forming Q)");
+    const Eigen::Index width = std::min(kBlock, dimension - first);
+    Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(n, width);
+    selector.block(rank + first, 0, width, width).setIdentity();
+    N.middleCols(first, width) = qr.matrixQ() * selector;
+  }
   return N;
 }
 

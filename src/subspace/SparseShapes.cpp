@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::subspace {
@@ -103,6 +104,8 @@ Positions sparseShape(const ConstraintMatrix& constraints, Index vertex, const E
   std::vector<char> mark(static_cast<std::size_t>(n), 0);
   const double target = settings.exactTolerance;
   while (residual > target * xNorm) {
+    // An iteration on a large support takes a second or more; a run may take thousands.
+    throwIfCancelled("the sparse shape (orthogonal matching pursuit)");
     // Most correlated unused atom (the lowest index among equals, as a scan of B^T r).
     Eigen::Index best = -1;
     double bestValue = 0.0;

@@ -138,5 +138,40 @@ TEST_F(InterruptCommand, SigtermStopsADeformationWithoutWritingIt) {
   EXPECT_EQ(slurp(dir_ / "previous.obj"), previous);
 }
 
+TEST_F(InterruptCommand, SigintStopsGenerateBeforeItWrites) {
+  // It ran to the end and replaced the output (800 MB for -n 3000). The generator itself
+  // runs on (3 s here); nothing is written after it.
+  const std::string previous = slurp(dir_ / "previous.obj");
+  const auto before = fileNames(dir_.path());
+  const Interrupted run =
+      runAndSignal({"generate", "translational", "-n", "1000", "-o", path("previous.obj")}, SIGINT, 300ms, log());
+  EXPECT_EQ(run.exitCode, 130) << run.err;
+  EXPECT_EQ(slurp(dir_ / "previous.obj"), previous);
+  EXPECT_EQ(fileNames(dir_.path()), before);
+}
+
+TEST_F(InterruptCommand, SigintStopsTheNullSpaceBasisOfALargeMesh) {
+  writeMesh(dir_ / "grid.obj", generate::translationalSurface(300, 300));
+  // It ran to the end (7 s here, minutes on a large mesh) and exited 0.
+  const Interrupted run = runAndSignal({"subspace", path("grid.obj"), "--report", path("r.json")}, SIGINT, 1000ms, log());
+  EXPECT_EQ(run.exitCode, 130) << run.err;
+  std::ifstream in(dir_ / "r.json");
+  ASSERT_TRUE(in) << "no report";
+  EXPECT_EQ(nlohmann::json::parse(in)["status"], "interrupted");
+}
+
+TEST_F(InterruptCommand, SigintStopsASparseShapeBetweenItsIterations) {
+  // The orthogonal matching pursuit ignored the signal: this one runs 16 s.
+  writeMesh(dir_ / "grid.obj", generate::translationalSurface(150, 150));
+  const std::string previous = slurp(dir_ / "previous.obj");
+  const auto start = std::chrono::steady_clock::now();
+  const Interrupted run = runAndSignal({"shapes", path("grid.obj"), "--vertex", "7000", "--kind", "sparse", "-o",
+                                       path("previous.obj"), "--max-support", "100000"},
+                                      SIGINT, 1000ms, log());
+  EXPECT_EQ(run.exitCode, 130) << run.err;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s) << run.err;
+  EXPECT_EQ(slurp(dir_ / "previous.obj"), previous);
+}
+
 }  // namespace
 }  // namespace plano::test

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "core/Cancellation.h"
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
@@ -94,6 +95,7 @@ RunFunction setup(CLI::App& app) {
               << nonMaximal.size() << " non-maximal face(s), " << seconds << " s\n";
     progress(global, "basis: " + j["basis_method"].get<std::string>() + ", rank " + std::to_string(space.basisInfo.rank) +
                          " of " + std::to_string(space.basisInfo.unknowns) + " unknowns");
+    throwIfCancelled("writing the report");
     writeReport(o->report, j);
     return 0;
   };
