@@ -7,6 +7,7 @@
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
 #include "plano/CommandOutcome.h"
+#include "plano/GenerateSize.h"
 #include "plano/Report.h"
 
 namespace plano::cli {
@@ -31,6 +32,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--report", options->report, "Write a JSON report to this file");
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
+    requireGeneratable(options->kind, options->n);
     const PolygonMesh mesh = generate::byName(options->kind, options->n);
     const PlanarityStats stats = planarityStats(mesh);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
