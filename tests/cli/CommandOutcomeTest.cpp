@@ -70,6 +70,16 @@ TEST_F(CommandOutcomeTest, NonFiniteResultIsAFailureNeverWrittenEvenWithKeepPart
   EXPECT_EQ(report()["output_written"], false);
 }
 
+TEST_F(CommandOutcomeTest, CoordinatesNoMeshFileMayHoldAreAFailureNeverWritten) {
+  // explore --amplitude 1e300 wrote a mesh that plano itself refused to read (beyond 1e100).
+  PolygonMesh huge = cube_;
+  huge.vertices(5, 2) = 1e200;
+  const std::string message = numericalFailureOf({"converged", ""}, true, huge);
+  EXPECT_NE(message.find("coordinates beyond 1e+100"), std::string::npos) << message;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out.obj"));
+  EXPECT_EQ(report()["status"], "out_of_range");
+}
+
 TEST_F(CommandOutcomeTest, InterruptionBeforeWritingWritesNothing) {
   requestCancellation();
   EXPECT_THROW(

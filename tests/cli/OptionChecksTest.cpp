@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
@@ -56,6 +58,60 @@ TEST(CommandOptions, WrittenFilesOverInputsOrIntoMissingFoldersAreRefusedBeforeT
   }
   EXPECT_EQ(std::filesystem::last_write_time(grid), before);
   EXPECT_EQ(test::runTool("-q subdivide " + grid + " --in-place --linear").exitCode, 0);
+}
+
+TEST(CommandOptions, OptionsThatWouldBeIgnoredOrOutOfTheirRangeAreUsageErrorsNamingThem) {
+  // Each ran before: silently ignoring the option, or (explore --amplitude 1e300) writing a
+  // mesh that plano refuses to read, or (embed --vertex 99) failing as bad input after the work.
+  const test::TempDir dir;
+  writeMesh(dir / "grid.obj", generate::translationalSurface(4, 4));
+  std::ofstream(dir / "c.json") << R"({"fixed": [0], "handles": [{"vertex": 24, "position": [1, 1, 1]}]})";
+  const std::string grid = (dir / "grid.obj").string(), out = (dir / "out.obj").string();
+  const std::string constraints = (dir / "c.json").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"explore " + grid + " -o " + out + " --amplitude 1e300", "--amplitude: must be in [-100, 100] (got 1e300)"},
+      {"shapes " + grid + " --vertex 3 -o " + out + " --amplitude -1e9", "--amplitude: must be in [-100, 100]"},
+      {"embed " + grid + " -o " + out + " --height 1e200", "--height: must be in [-100, 100]"},
+      {"prescribe " + grid + " --map warp --strength 2 -o " + out, "--strength: must be in (-2, 2) (got 2)"},
+      {"prescribe " + grid + " --map rotate --point 1 2 3 -o " + out, "--point is the centre of --pivot point"},
+      {"embed " + grid + " -o " + out + " --lift handle --vertex -3", "--vertex: must be >= 0 (got -3)"},
+      {"embed " + grid + " -o " + out + " --lift handle --vertex 99", "--vertex 99 is out of range"},
+      {"embed " + grid + " -o " + out + " --vertex 3", "--vertex is the handle of --lift handle"},
+      {"deform " + grid + " --constraints " + constraints + " -o " + out + " --base " + grid, "--base requires --multires"},
+      {"deform " + grid + " --constraints " + constraints + " -o " + out + " --scheme four-point",
+       "--scheme requires --multires"},
+      {"deform " + grid + " --constraints " + constraints + " -o " + out + " --multires-level 1",
+       "--multires-level requires --multires"},
+      {"subspace " + grid + " --rank-tolerance -1", "--rank-tolerance: must be > 0 (got -1)"},
+  };
+  for (const auto& [command, message] : cases) {
+    const test::ToolResult result = test::runTool("-q " + command);
+    EXPECT_EQ(result.exitCode, 2) << command << "\n" << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << command << "\n" << result.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << command;
+  }
+}
+
+TEST(CommandOptions, MessagesOfNumericChecksAreShortAndNameTheValueGiven) {
+  // CLI11's own ranges printed the largest double in 300 digits; the generator named the
+  // number of quads around the axis (2n), not the -n given.
+  const test::TempDir dir;
+  writeMesh(dir / "grid.obj", generate::translationalSurface(4, 4));
+  const std::string grid = (dir / "grid.obj").string(), out = (dir / "out.obj").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"info " + grid + " --tolerance 0", "--tolerance: must be > 0 (got 0)"},
+      {"planarize " + grid + " -o " + out + " --tolerance inf", "--tolerance: must be finite (got inf)"},
+      {"planarize " + grid + " -o " + out + " --closeness -1", "--closeness: must be >= 0 (got -1)"},
+      {"explore " + grid + " -o " + out + " --eigenshapes 0", "--eigenshapes: must be > 0 (got 0)"},
+      {"generate revolution -n 1 -o " + out, "-n must be at least 2 (got 1)"},
+      {"planarize " + grid, "--output is required"},
+  };
+  for (const auto& [command, message] : cases) {
+    const test::ToolResult result = test::runTool("-q " + command);
+    EXPECT_EQ(result.exitCode, 2) << command << "\n" << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << command << "\n" << result.err;
+    EXPECT_LT(result.err.size(), 300u) << result.err;
+  }
 }
 
 }  // namespace

@@ -40,6 +40,18 @@ struct CommandRegistration {
   explicit CommandRegistration(CommandInfo info) { commandRegistry().push_back(std::move(info)); }
 };
 
+/// Checks of numeric options whose messages say what is wrong in the user's terms
+/// ("--tolerance: must be > 0 (got 0)", "must be finite (got inf)") rather than CLI11's
+/// ranges up to the largest double written out in 300 digits.
+CLI::Validator positiveNumber();     ///< Finite and > 0.
+CLI::Validator nonNegativeNumber();  ///< Finite and >= 0.
+/// Finite and within [low, high], or (low, high) when `open`.
+CLI::Validator numberBetween(double low, double high, bool open = false);
+
+/// Bound of the options that scale a displacement by the bounding-box diagonal (--amplitude,
+/// --height): far beyond any useful edit, and far from coordinates no mesh file may hold.
+constexpr double kMaxAmplitude = 100.0;
+
 /// Create the backend the user asked for, printing a fallback warning on stderr.
 std::unique_ptr<compute::Backend> makeBackend(const GlobalOptions& options);
 

@@ -55,6 +55,49 @@ std::unique_ptr<compute::Backend> makeLinearSpaceBackend(const GlobalOptions& op
   return backend;
 }
 
+namespace {
+
+/// A validator of the number an option's text holds: `problem` returns what is wrong with a
+/// finite value, or "" when nothing is. Text that is no number is left to CLI11's conversion.
+CLI::Validator numberCheck(std::function<std::string(double)> problem, const std::string& description) {
+  return CLI::Validator(
+      [problem](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value)) return {};
+        if (!std::isfinite(value)) return "must be finite (got " + text + ")";
+        const std::string why = problem(value);
+        return why.empty() ? why : why + " (got " + text + ")";
+      },
+      description);
+}
+
+/// A bound as the user would write it: 2, 0.5, 1e+06.
+std::string shortNumber(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+}  // namespace
+
+CLI::Validator positiveNumber() {
+  return numberCheck([](double value) { return value > 0.0 ? "" : "must be > 0"; }, "POSITIVE");
+}
+
+CLI::Validator nonNegativeNumber() {
+  return numberCheck([](double value) { return value >= 0.0 ? "" : "must be >= 0"; }, "NONNEGATIVE");
+}
+
+CLI::Validator numberBetween(double low, double high, bool open) {
+  const std::string range = (open ? "(" : "[") + shortNumber(low) + ", " + shortNumber(high) + (open ? ")" : "]");
+  return numberCheck(
+      [=](double value) -> std::string {
+        const bool inside = open ? (value > low && value < high) : (value >= low && value <= high);
+        return inside ? "" : "must be in " + range;
+      },
+      "in " + range);
+}
+
 void progress(const GlobalOptions& options, const std::string& message) {
   if (!options.quiet) std::cerr << message << std::endl;
 }
@@ -85,7 +128,7 @@ void requireFiniteFloatOptions(CLI::App& app) {
   const CLI::Validator finite(
       [](std::string& text) -> std::string {
         double value = 0.0;
-        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value)) return "must be finite, got " + text;
+        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value)) return "must be finite (got " + text + ")";
         return {};
       },
       "");

@@ -281,7 +281,7 @@ RunFunction setup(CLI::App& app) {
       ->check(CLI::IsMember({"rigid", "similar"}))
       ->capture_default_str();
   app.add_option("--smoothness", options->smoothness, "alpha of the map-smoothness term (paper §6.3)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   app.add_option("--max-iterations", options->maxIterations, "Local/global iterations of the rigid/similar phase")
       ->check(CLI::Range(1, 100000))
@@ -289,25 +289,29 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--tolerance", options->tolerance,
                  "Stop when the max vertex displacement per iteration is below this fraction of the bounding-box "
                  "diagonal")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   app.add_option("--planarity-tolerance", options->planarityTolerance,
                  "Max face planarity (percent) the result must reach")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   app.add_option("--report", options->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, options->keepPartial);
   app.add_flag("--in-place", options->inPlace, "Allow the output to overwrite the input mesh");
   // Multi-resolution editing (paper §6).
-  app.add_flag("--multires", options->multires,
+  CLI::Option* multires = app.add_flag("--multires", options->multires,
                "Multi-resolution editing: deform on the coarsest admissible level of the subdivision hierarchy of "
                "--base and prolong (smoothness defaults to 3.5)");
-  app.add_option("--base", options->base, "With --multires: the coarse mesh that MESH was subdivided from");
+  // Without --multires these would be ignored silently.
+  app.add_option("--base", options->base, "With --multires: the coarse mesh that MESH was subdivided from")
+      ->needs(multires);
   app.add_option("--scheme", options->scheme, "With --multires: the scheme MESH was subdivided with")
       ->check(CLI::IsMember({"catmull-clark", "four-point"}))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(multires);
   app.add_option("--multires-level", options->multiresLevel,
-                 "With --multires: deform on this level instead of the automatic choice");
+                 "With --multires: deform on this level instead of the automatic choice")
+      ->needs(multires);
   // Deformation inside a linear space (linear-spaces paper §3, Fig. 8).
   addLinearSpaceOptions(app, options->linearSpace,
                         "Deform inside a linear space of polyhedral meshes instead of the projective shape space "

@@ -41,6 +41,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--eigenshape", o->eigenshape, "Which eigenshape of the dual's space to add (0 = lowest)")
       ->capture_default_str();
   app.add_option("--amplitude", o->amplitude, "Peak displacement of the dual, relative to its bounding-box diagonal")
+      ->check(numberBetween(-kMaxAmplitude, kMaxAmplitude))
       ->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);

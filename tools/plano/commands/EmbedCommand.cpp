@@ -4,6 +4,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "core/Error.h"
 #include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 #include "plano/Command.h"
@@ -33,16 +34,28 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--lift", o->lift, "eigenshape | handle | none")
       ->check(CLI::IsMember({"eigenshape", "handle", "none"}))
       ->capture_default_str();
-  app.add_option("--height", o->height, "Largest height relative to the bounding-box diagonal")->capture_default_str();
+  app.add_option("--height", o->height, "Largest height relative to the bounding-box diagonal")
+      ->check(numberBetween(-kMaxAmplitude, kMaxAmplitude))
+      ->capture_default_str();
   app.add_option("--eigenshape", o->eigenshape, "Which non-planar lifting eigenshape (0 = lowest)")->capture_default_str();
-  app.add_option("--vertex", o->vertex, "Handle vertex (default: the one nearest the centre)");
+  const CLI::Option* vertex =
+      app.add_option("--vertex", o->vertex, "With --lift handle: the handle vertex (default: the one nearest the centre)")
+          ->check(nonNegativeNumber());
   app.add_option("--report", o->report, "Write a JSON report to this file");
   addKeepPartialFlag(app, o->keepPartial);
-  return [o](const GlobalOptions& global) {
+  return [o, vertex](const GlobalOptions& global) {
+    if (vertex->count() > 0 && o->lift != "handle") {
+      throwUsage("embed: --vertex is the handle of --lift handle (got --lift " + o->lift + ")");
+    }
     const auto backend =
         makeLinearSpaceBackend(global, "embed", "the Tutte solve and the lifting's reduced operator run");
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh topology = readMesh(o->input);
+    // Before the embedding, as shapes --vertex: a usage error, not bad input after the work.
+    if (vertex->count() > 0 && o->vertex >= topology.vertexCount()) {
+      throwUsage("--vertex " + std::to_string(o->vertex) + " is out of range (" + o->input + " has " +
+                 std::to_string(topology.vertexCount()) + " vertices)");
+    }
     TutteInfo tutte;
     PolygonMesh out{tutteEmbedding(*backend, topology.faces, topology.vertexCount(), {}, &tutte), topology.faces};
     progress(global, "Tutte embedding: " + std::to_string(tutte.boundaryVertices) + " boundary vertices, " +

@@ -45,9 +45,10 @@ RunFunction setup(CLI::App& app) {
   addLinearSpaceOptions(app, o->linearSpace);
   app.add_option("--eigenshapes", o->eigenshapes, "Number of eigenshapes to compute")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   app.add_option("--band", o->band, "Eigenshapes LO:HI (HI exclusive) to add; default all");
   app.add_option("--amplitude", o->amplitude, "Peak displacement per eigenshape, relative to the bounding-box diagonal")
+      ->check(numberBetween(-kMaxAmplitude, kMaxAmplitude))
       ->capture_default_str();
   app.add_option("-o,--output", o->output, "Output mesh")->required();
   app.add_option("--report", o->report, "Write a JSON report to this file");

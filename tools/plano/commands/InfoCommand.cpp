@@ -96,7 +96,7 @@ RunFunction setup(CLI::App& app) {
   app.add_flag("--json", options->json, "Print the report as JSON on stdout");
   app.add_option("--tolerance", options->tolerance, "Planarity tolerance in percent for the over-tolerance count")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   app.add_option("--report", options->report, "Also write the JSON report to this file");
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();

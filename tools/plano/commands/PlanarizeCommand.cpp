@@ -54,14 +54,16 @@ nlohmann::json reportJson(const PlanarizeOptions& options, const planarize::Sett
 RunFunction setup(CLI::App& app) {
   auto options = std::make_shared<PlanarizeOptions>();
   app.add_option("mesh", options->input, "Input mesh (.obj, .off, .ply)")->required();
-  app.add_option("-o,--output", options->output, "Output mesh (.obj, .off, .ply)");
+  app.add_option("-o,--output", options->output,
+                 "Output mesh (.obj, .off, .ply); the input itself only with --in-place")
+      ->required();
   app.add_option("--tolerance", options->tolerance, "Max face planarity to reach, percent")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   app.add_option("--closeness", options->closeness,
                  "Weight of staying close to the input (larger: less displacement, slower or no convergence)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   app.add_option("--fixed", options->fixed, "Constraints JSON whose \"fixed\" vertices keep their positions");
   app.add_option("--method", options->method,
                  "gauss-newton (fastest), guided (plane unknowns), anderson (accelerated shapeup), shapeup (reference)")
@@ -75,7 +77,6 @@ RunFunction setup(CLI::App& app) {
   app.add_flag("--in-place", options->inPlace, "Allow the output to be the input file");
   return [options](const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
-    if (options->output.empty()) throwUsage("planarize: no output file (use -o OUT)");
     PolygonMesh mesh = readMesh(options->input);
     planarize::Settings settings;
     settings.method = planarize::parseMethod(options->method);

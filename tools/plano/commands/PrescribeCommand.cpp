@@ -56,19 +56,25 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--angle", options->angle, "Rotation angle in degrees")->capture_default_str();
   app.add_option("--strength", options->strength,
                  "Warp: change of the homogeneous weight per bounding-box diagonal along the axis (|k| < 2)")
+      ->check(numberBetween(-2.0, 2.0, /*open=*/true))
       ->capture_default_str();
   app.add_option("--t", options->scale, "Scaling factor t (0: as-minimal-as-possible)")->capture_default_str();
   app.add_option("--pivot", options->pivot, "Centre of the maps: centre (of the mesh), face (each face's centroid), point")
       ->check(CLI::IsMember({"centre", "face", "point"}))
       ->capture_default_str();
-  app.add_option("--point", options->point, "Pivot point for --pivot point (3 numbers)")->expected(3);
+  const CLI::Option* point =
+      app.add_option("--point", options->point, "Pivot point for --pivot point (3 numbers)")->expected(3);
   app.add_option("--faces", options->faces, "Faces that get the map (0-based; default all), others get the identity")
       ->delimiter(',');
   app.add_option("--constraints", options->constraints, "JSON constraints file: fixed vertices and handles");
   app.add_option("--report", options->report, "Write a JSON report to this file");
   app.add_flag("--in-place", options->inPlace, "Allow the output to overwrite the input mesh");
   addKeepPartialFlag(app, options->keepPartial);
-  return [options](const GlobalOptions& global) {
+  return [options, point](const GlobalOptions& global) {
+    // Otherwise silently ignored: the maps would turn about another centre than the one given.
+    if (point->count() > 0 && options->pivot != "point") {
+      throwUsage("prescribe: --point is the centre of --pivot point (got --pivot " + options->pivot + ")");
+    }
     const auto start = std::chrono::steady_clock::now();
     const PolygonMesh mesh = readMesh(options->input);
     PositionalConstraints constraints;

@@ -42,7 +42,9 @@ RunFunction setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--vertex", o->vertex, "The vertex the shape moves")->required();
   app.add_option("--direction", o->direction, "Direction X,Y,Z (default: the vertex normal)")->delimiter(',')->expected(3);
-  app.add_option("--amplitude", o->amplitude, "Peak displacement relative to the bounding-box diagonal")->capture_default_str();
+  app.add_option("--amplitude", o->amplitude, "Peak displacement relative to the bounding-box diagonal")
+      ->check(numberBetween(-kMaxAmplitude, kMaxAmplitude))
+      ->capture_default_str();
   app.add_option("--smoothness", o->smoothness, "lambda of the fundamental shape")->capture_default_str();
   app.add_option("--max-support", o->maxSupport, "Sparse shape: most vertices that may move (the seed included)")
       ->check(CLI::Range(Index{1}, Index{1'000'000'000}))

@@ -70,7 +70,7 @@ RunFunction setup(CLI::App& app) {
   app.add_option("--tolerance", options->tolerance,
                  "Max planarity in percent (default 0.1 for catmull-clark, 0.5 for four-point); "
                  "the input's trivially refined faces must meet it")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   app.add_option("--max-iterations", options->maxIterations, "Local/global iterations per level at most")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));

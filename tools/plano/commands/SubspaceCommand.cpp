@@ -37,7 +37,9 @@ RunFunction setup(CLI::App& app) {
   app.add_option("mesh", o->input, "Polyhedral mesh (.obj, .off, .ply)")->required();
   addLinearSpaceOptions(app, o->linearSpace);
   app.add_flag("--reassign", o->reassign, "Reassign faces whose space is not maximal (Fig. 4) before reporting");
-  app.add_option("--rank-tolerance", o->rankTolerance, "Relative rank tolerance of B")->capture_default_str();
+  app.add_option("--rank-tolerance", o->rankTolerance, "Relative rank tolerance of B")
+      ->check(positiveNumber())
+      ->capture_default_str();
   app.add_option("--report", o->report, "Write a JSON report to this file");
   return [o](const GlobalOptions& global) {
     const std::string backend =
