@@ -165,8 +165,24 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   state.counters["polish_linear_iterations"] = static_cast<double>(info.linearIterations - split.admm());
 }
 
+/// Which iterations of a deformation BM_DeformationIteration times.
+enum class DeformationTiming {
+  /// Each from the base mesh, the first timed one with the solvers' set-up (at the large
+  /// sizes the only one that runs); zero multipliers as in Steady.
+  First,
+  /// Each from the base mesh again, after one untimed iteration, so that the timed ones
+  /// find their solvers made (matrices uploaded, the factorization's analysis done), with
+  /// the solver state (rho) the last one left; their exact steps start from zero
+  /// multipliers (from the last one's, the identical problem's, they would start solved).
+  Steady,
+  /// Iterations 2 .. 9 of one deformation (fixed count): each continues from the mesh the
+  /// last one left, as a drag's next frames, its exact step started from the last one's
+  /// multipliers (GlobalStepSettings::qp, BoxQpSettings::warmStartEqualities).
+  Continued,
+};
+
 /// One as-rigid-as-possible iteration: fixed row, corner handle lifted.
-void BM_DeformationIteration(benchmark::State& state, BackendChoice choice, bool steady) {
+void BM_DeformationIteration(benchmark::State& state, BackendChoice choice, DeformationTiming timing) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
@@ -179,27 +195,27 @@ void BM_DeformationIteration(benchmark::State& state, BackendChoice choice, bool
   plano::projective::DeformationSettings settings;
   settings.maxIterations = 1;
   settings.maxProjectionIterations = 0;
+  settings.global.qp.warmStartEqualities = timing == DeformationTiming::Continued;
   plano::projective::Deformation deformation(*backend, mesh, constraints, settings);
   plano::Positions handles(1, 3);
   handles.row(0) = constraints.handles[0].position.transpose();
   int admm = 0;
-  // Steady: one untimed iteration first, so that the timed ones find their solvers made
-  // (matrices uploaded, the factorization's analysis done), as from a deformation's
-  // second iteration on; each restarts from the base mesh, with the solver state (rho) the
-  // last one left.
-  if (steady) {
-    plano::Positions positions = mesh.vertices;
-    deformation.solve(handles, positions);
-  }
+  long linear = 0;
+  plano::Positions positions = mesh.vertices;
+  if (timing != DeformationTiming::First) deformation.solve(handles, positions);
   memory.markLoopStart();
   for (auto _ : state) {
-    plano::Positions positions = mesh.vertices;
+    if (timing != DeformationTiming::Continued) positions = mesh.vertices;
     const auto info = deformation.solve(handles, positions);
     admm = info.history.empty() ? 0 : info.history.back().admmIterations;
+    linear = info.history.empty() ? 0 : info.history.back().linearIterations;
     benchmark::DoNotOptimize(positions.data());
   }
   plano::bench::setFaceCounters(state, mesh);
+  // The last timed iteration's: ADMM iterations (0 where the exact step is solved directly)
+  // and the iterations of their solves with K (PCG iterations on a device).
   state.counters["admm_iterations"] = admm;
+  state.counters["linear_iterations"] = static_cast<double>(linear);
 }
 
 /// Reciprocal scale factors in [0.8, 1.2], one per corner.
@@ -425,13 +441,17 @@ BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, filled, true)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DeformationIteration, cpu, BackendChoice::Cpu, false)
+BENCHMARK_CAPTURE(BM_DeformationIteration, cpu, BackendChoice::Cpu, DeformationTiming::First)
     ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan, BackendChoice::Vulkan, false)
+BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan, BackendChoice::Vulkan, DeformationTiming::First)
     ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DeformationIteration, cpu_steady, BackendChoice::Cpu, true)
+BENCHMARK_CAPTURE(BM_DeformationIteration, cpu_steady, BackendChoice::Cpu, DeformationTiming::Steady)
     ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan_steady, BackendChoice::Vulkan, true)
+BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan_steady, BackendChoice::Vulkan, DeformationTiming::Steady)
     ->Arg(256)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeformationIteration, cpu_continued, BackendChoice::Cpu, DeformationTiming::Continued)
+    ->Arg(256)->Arg(4096)->Arg(65536)->Iterations(8)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeformationIteration, vulkan_continued, BackendChoice::Vulkan, DeformationTiming::Continued)
+    ->Arg(256)->Arg(4096)->Arg(65536)->Iterations(8)->Unit(benchmark::kMillisecond);
 
 }  // namespace

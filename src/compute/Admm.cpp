@@ -81,12 +81,17 @@ class HostAdmmKernels final : public AdmmKernels {
   }
 
   void start(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const DeviceMatrix& x, const Eigen::MatrixXd& y) override {
+             const DeviceMatrix& x, const Eigen::MatrixXd& y, WarmStart warm) override {
     q_ = q.values();
     lower_ = lower;
     upper_ = upper;
-    x_ = x.size() > 0 ? x.values() : Eigen::MatrixXd::Zero(q.rows(), q.cols());
-    y_ = y.size() > 0 ? y : Eigen::MatrixXd::Zero(lower.rows(), q.cols());
+    // A held iterate exists once a start set one of these sizes.
+    const bool held = warm == WarmStart::Kept && x_.rows() == q.rows() && x_.cols() == q.cols() &&
+                      y_.rows() == lower.rows() && y_.cols() == q.cols();
+    if (!held) {
+      x_ = x.size() > 0 ? x.values() : Eigen::MatrixXd::Zero(q.rows(), q.cols());
+      y_ = y.size() > 0 ? y : Eigen::MatrixXd::Zero(lower.rows(), q.cols());
+    }
     z_ = (C_ * x_).cwiseMax(lower_).cwiseMin(upper_);
     xTilde_ = x_;
     yPrevious_ = y_;
@@ -346,7 +351,8 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds
 }
 
 AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                             const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y) {
+                             const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
+                             WarmStart warm) {
   if (relaxed) {
     if (relaxed->centre.rows() != m_ || relaxed->centre.cols() != q.cols() ||
         relaxed->relaxed.size() != static_cast<std::size_t>(m_)) {
@@ -372,9 +378,9 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
   kernels_->setRelaxation(allEqualities ? settings_.equalityRelaxation : settings_.relaxation);
   AdmmInfo info;
   if (relaxed) {
-    kernels_->startRelaxed(q, *relaxed, x, y);
+    kernels_->startRelaxed(q, *relaxed, x, y, warm);
   } else {
-    kernels_->start(q, lower, upper, x, y);
+    kernels_->start(q, lower, upper, x, y, warm);
   }
 
   // An attempt resolves its own eps (AdmmSettings::epsilonToleranceFraction).

@@ -218,6 +218,18 @@ struct AdmmMeasures {
   long inexactSolves = 0;          ///< Since start().
 };
 
+/// What a solve starts from (AdmmKernels::start).
+enum class WarmStart {
+  Given,  ///< The x and y given (zero where empty).
+  /// The x and y the kernels hold: their last solve's result (polished where the polish ran
+  /// on them), nothing crossing to a device; before any solve, the given ones. For a loop's
+  /// next solve of a problem with the same rows and nearby data (OSQP's warm_start); the
+  /// caller decides when the held ones are a good start (not after a failed or differently
+  /// bounded solve). Both count: with over-relaxation a good y alone is spoilt by the first
+  /// step from a poor x (x1 = alpha xTilde + (1 - alpha) x0).
+  Kept,
+};
+
 /// Which bound the polish holds a row of a column at (AdmmKernels::findActiveSides).
 enum class BoundSide : std::uint8_t { Free, Lower, Upper };
 
@@ -276,15 +288,16 @@ class AdmmKernels {
   }
   /// Load q (n x k), bounds (m x k) and warm starts x (n x k) and y (m x k), each of which
   /// may be empty for zero (set where the kernels keep the iterate: nothing copied to a
-  /// device); z = clamp(C x, l, u), xTilde = x. q and x may be device matrices (DeviceMatrix):
+  /// device); z = clamp(C x, l, u), xTilde = x. With WarmStart::Kept the x and y the kernels
+  /// hold stay (the given ones serve before any solve). q and x may be device matrices (DeviceMatrix):
   /// kernels that keep the iterate where those live bind them, others read their values.
   virtual void start(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                     const DeviceMatrix& x, const Eigen::MatrixXd& y) = 0;
+                     const DeviceMatrix& x, const Eigen::MatrixXd& y, WarmStart warm) = 0;
   /// start() with l and u given as a relaxation (RelaxedBounds, checked by the caller). The
   /// default forms them on the host; kernels that keep the iterate on a device form them there.
   virtual void startRelaxed(const DeviceMatrix& q, const RelaxedBounds& bounds, const DeviceMatrix& x,
-                            const Eigen::MatrixXd& y) {
-    start(q, bounds.lower(), bounds.upper(), x, y);
+                            const Eigen::MatrixXd& y, WarmStart warm) {
+    start(q, bounds.lower(), bounds.upper(), x, y, warm);
   }
   /// The over-relaxation alpha of the following iterate() calls (AdmmSolver sets it before
   /// each solve: AdmmSettings::relaxation, or equalityRelaxation for an all-equality problem).
@@ -376,9 +389,11 @@ class AdmmSolver {
   /// solve() without fetching the iterate: it stays where the kernels keep it, for the
   /// polish's steps below, until download(). `relaxed`, when not null, is the bounds' form
   /// the kernels start from (lower and upper must be its l and u).
-  /// q and x may be device matrices (AdmmKernels::start).
+  /// q and x may be device matrices (AdmmKernels::start); WarmStart::Kept starts from the
+  /// iterate the last solve left (x and y then serve only before any solve).
   AdmmInfo iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                   const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y);
+                   const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
+                   WarmStart warm = WarmStart::Given);
   /// max |C x - centre| over all rows and columns of relaxed bounds (their centre; epsilon
   /// is not used), measured where the kernels keep the iterate: they are started at x (the
   /// next solve starts again), and a q, centre and flags that the next start shares are

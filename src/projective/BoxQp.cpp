@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/Error.h"
@@ -169,7 +170,10 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
                              const Eigen::MatrixXd& upper, const compute::RelaxedBounds* relaxed,
                              const compute::DeviceMatrix* start, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
                              compute::DeviceMatrix* kept) {
-  if (lower.size() > 0 && lower == upper) {
+  const bool allEqualities = lower.size() > 0 && lower == upper;
+  const bool held = std::exchange(equalityIterateHeld_, false);
+  compute::WarmStart warm = compute::WarmStart::Given;
+  if (allEqualities) {
     const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
                         (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
     BoxQpInfo info;
@@ -181,14 +185,20 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
         return info;
       }
     }
-    // The ADMM of an all-equality problem starts at the initial rho, not at the one the
-    // last solve ended at (raised there by the stiff rows): on a 16-face deformation
-    // (21 steps at ε = 0) on lavapipe the same 430 ADMM iterations, but 45 901 -> 18 358
-    // PCG iterations in its solves with K, which that rho made stiffer (4.8 -> 2.5 s).
-    admm_->setRho(settings_.rho);
+    if (settings_.warmStartEqualities && held && y.size() == 0) {
+      // The last solve's iterate and rho (BoxQpSettings::warmStartEqualities).
+      warm = compute::WarmStart::Kept;
+    } else {
+      // From zero multipliers, the ADMM of an all-equality problem starts at the initial
+      // rho, not at the one the last solve ended at (raised there by the stiff rows): on a
+      // 16-face deformation (21 steps at ε = 0) on lavapipe the same 430 ADMM iterations,
+      // but 45 901 -> 18 358 PCG iterations in its solves with K, which that rho made
+      // stiffer (4.8 -> 2.5 s).
+      admm_->setRho(settings_.rho);
+    }
   }
-  const compute::AdmmInfo admm =
-      start ? admm_->iterate(q, lower, upper, relaxed, *start, y) : admm_->iterate(q, lower, upper, relaxed, x, y);
+  const compute::AdmmInfo admm = start ? admm_->iterate(q, lower, upper, relaxed, *start, y, warm)
+                                       : admm_->iterate(q, lower, upper, relaxed, x, y, warm);
   BoxQpInfo info;
   info.status = toBoxQpStatus(admm.status);
   info.iterations = admm.iterations;
@@ -222,6 +232,7 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   }
   // On the device the kernels measure it at the iterate they keep: the solution.
   info.maxBoundViolation = onDevice ? admm_->boundViolation() : boundViolation(hostC() * x, lower, upper);
+  equalityIterateHeld_ = allEqualities && isSolved(info.status);
   if (info.polished) info.primalResidual = info.maxBoundViolation;
   if (kept && !onDevice) *kept = compute::DeviceMatrix(std::move(x));
   return info;

@@ -216,7 +216,7 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
   // scales on a device form C's values there.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  qpSettings.returnDuals = false;      // every attempt starts from zero duals
+  qpSettings.returnDuals = false;      // zero duals or those the ADMM keeps (solveEpsilonSchedule)
   BoxQpSolver* solver = nullptr;
   if (shat.onHost()) {
     const Eigen::MatrixXd& scales = shat.values();

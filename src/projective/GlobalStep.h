@@ -75,10 +75,14 @@ struct GlobalStepSettings {
   /// stop at their first converged iteration (AdmmSettings::convergenceCheckSolveIterations):
   /// the ~256-face exact step of BM_GlobalStep/vulkan 30 -> 22 ADMM and 6 208 -> 4 944 PCG
   /// iterations; the CPU's iteration is unchanged.
+  /// An ε = 0 attempt solved by the ADMM (an iterative backend's) after one of the last step
+  /// starts from that one's multipliers and rho (BoxQpSettings::warmStartEqualities); the
+  /// CPU solves those attempts directly.
   BoxQpSettings qp = [] {
     BoxQpSettings s;
     s.preconditioner = compute::AdmmPreconditioner::Automatic;
     s.convergenceCheckSolveIterations = 8;
+    s.warmStartEqualities = true;
     return s;
   }();
 };
@@ -195,8 +199,9 @@ class GlobalStep {
 /// coarse step's): q = -T, the initial violation max |C T - bounds.centre| measured where
 /// the QP runs, eps_0 = initialEpsilonFraction times it (eps = 0 first for ExactFirst), then
 /// eps grows by epsilonGrowth until an attempt converges. Each attempt starts from the
-/// targets T (4 #F x 3, possibly a device matrix) with zero duals (the QP's settings must
-/// not return duals). x receives the accepted solution where the QP left it; info the
+/// targets T (4 #F x 3, possibly a device matrix) with zero duals, or, an ε = 0 attempt
+/// after the last step's solved one, with that one's (BoxQpSettings::warmStartEqualities,
+/// where the ADMM keeps them: the QP's settings must not return duals). x receives the accepted solution where the QP left it; info the
 /// violation, the attempts, their iteration counts and the solution's residuals. `what`
 /// names the step in errors: Error(Numerical) for a non-finite target (naming its face) or
 /// iterate, and for an exhausted schedule.

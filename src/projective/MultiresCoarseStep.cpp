@@ -128,7 +128,7 @@ GlobalStepInfo MultiresCoarseStep::solveAffine(const compute::DeviceMatrix& line
   // object's lifetime.
   BoxQpSettings qpSettings = settings_.qp;
   qpSettings.preconditionerBlock = 4;  // rows 4f..4f+3: the entries of face f's map, coupled in K
-  qpSettings.returnDuals = false;      // every attempt starts from zero duals
+  qpSettings.returnDuals = false;      // zero duals or those the ADMM keeps (solveEpsilonSchedule)
   BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
   GlobalStepInfo info;
   compute::RelaxedBounds bounds{std::move(d), std::move(relaxed), 0.0};

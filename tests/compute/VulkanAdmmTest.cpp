@@ -591,18 +591,19 @@ TEST_F(VulkanAdmm, SmallProblemsRunInOneWorkgroupAndWideOnesRefuseIt) {
   const compute::AdmmSettings settings;
   vk::AdmmKernels automatic(context(), qp.P, qp.C, settings);
   automatic.setRho(std::vector<char>(30, 0), 0.1);
-  automatic.start(qp.q, qp.lower, qp.upper, Eigen::MatrixXd::Zero(40, 3), Eigen::MatrixXd::Zero(30, 3));
+  automatic.start(qp.q, qp.lower, qp.upper, Eigen::MatrixXd::Zero(40, 3), Eigen::MatrixXd::Zero(30, 3),
+                  compute::WarmStart::Given);
   EXPECT_TRUE(automatic.singleWorkgroup());
 
   // Five columns exceed the kernel's four: automatic falls back, forced throws.
   const Eigen::MatrixXd q = Eigen::MatrixXd::Zero(40, 5), bounds = Eigen::MatrixXd::Zero(30, 5);
   const Eigen::MatrixXd x = Eigen::MatrixXd::Zero(40, 5), y = Eigen::MatrixXd::Zero(30, 5);
-  automatic.start(q, bounds, bounds, x, y);
+  automatic.start(q, bounds, bounds, x, y, compute::WarmStart::Given);
   EXPECT_FALSE(automatic.singleWorkgroup());
   vk::AdmmKernels forced(context(), qp.P, qp.C, settings, vk::AdmmRecording::SingleWorkgroup);
   forced.setRho(std::vector<char>(30, 0), 0.1);
   try {
-    forced.start(q, bounds, bounds, x, y);
+    forced.start(q, bounds, bounds, x, y, compute::WarmStart::Given);
     ADD_FAILURE() << "five columns were accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Device);
@@ -642,7 +643,7 @@ TEST_F(VulkanAdmm, AStartWithTheLastStartsQUploadsTheRestOnly) {
   const Eigen::MatrixXd wider = qp.upper.array() + 0.5;
   const auto uploadsOfStart = [&](const Eigen::MatrixXd& q) {
     const vk::TransferCounts before = context().transfers();
-    kernels.start(q, qp.lower, wider, qp.x, qp.y);
+    kernels.start(q, qp.lower, wider, qp.x, qp.y, compute::WarmStart::Given);
     const vk::TransferCounts after = context().transfers();
     return std::pair{after.uploads - before.uploads, after.uploadedBytes - before.uploadedBytes};
   };
@@ -653,13 +654,13 @@ TEST_F(VulkanAdmm, AStartWithTheLastStartsQUploadsTheRestOnly) {
   EXPECT_EQ(other.second - same.second, sizeof(double) * 24 * 3);
   // The kept q (the last start's) is the one solved with: the same iterate as a fresh start's.
   const Eigen::MatrixXd q = qp.q * 2.0;
-  kernels.start(q, qp.lower, qp.upper, qp.x, qp.y);
+  kernels.start(q, qp.lower, qp.upper, qp.x, qp.y, compute::WarmStart::Given);
   kernels.iterate(10);
   Eigen::MatrixXd x, y, z;
   kernels.download(x, y, z);
   vk::AdmmKernels fresh(context(), qp.P, qp.C, tightSettings(), vk::AdmmRecording::SingleWorkgroup);
   fresh.setRho(std::vector<char>(18, 0), 0.1);
-  fresh.start(q, qp.lower, qp.upper, qp.x, qp.y);
+  fresh.start(q, qp.lower, qp.upper, qp.x, qp.y, compute::WarmStart::Given);
   fresh.iterate(10);
   Eigen::MatrixXd xFresh, yFresh, zFresh;
   fresh.download(xFresh, yFresh, zFresh);
@@ -691,7 +692,7 @@ TEST_F(VulkanAdmm, RelaxedBoundsAndTheTargetsAsWarmStartAreFormedOnTheDeviceGivi
       relaxed.setRho(equality, 0.1);
       uploaded.setRho(equality, 0.1);
       const vk::TransferCounts before = context().transfers();
-      relaxed.startRelaxed(qp.q, bounds, targets, Eigen::MatrixXd());
+      relaxed.startRelaxed(qp.q, bounds, targets, Eigen::MatrixXd(), compute::WarmStart::Given);
       const vk::TransferCounts after = context().transfers();
       if (epsilon > 0.05) {
         // Only the state (with epsilon, a few scalars) crosses: no bound, no warm start, no q.
@@ -705,7 +706,8 @@ TEST_F(VulkanAdmm, RelaxedBoundsAndTheTargetsAsWarmStartAreFormedOnTheDeviceGivi
         EXPECT_EQ(x0, targets);
         EXPECT_EQ(y0, Eigen::MatrixXd::Zero(18, 3));
       }
-      uploaded.start(qp.q, bounds.lower(), bounds.upper(), Eigen::MatrixXd(targets), Eigen::MatrixXd::Zero(18, 3));
+      uploaded.start(qp.q, bounds.lower(), bounds.upper(), Eigen::MatrixXd(targets), Eigen::MatrixXd::Zero(18, 3),
+                     compute::WarmStart::Given);
       for (vk::AdmmKernels* kernels : {&relaxed, &uploaded}) kernels->iterate(10);
       Eigen::MatrixXd x, y, z, xUploaded, yUploaded, zUploaded;
       relaxed.download(x, y, z);
@@ -1077,7 +1079,7 @@ class RecordingKernels final : public compute::AdmmKernels {
   void setConstraintScaling(const compute::ConstraintScaling& scaling) override { inner_->setConstraintScaling(scaling); }
   void setConstraintScales(std::span<const double> scales) override { inner_->setConstraintScales(scales); }
   void start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override {
+             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y, compute::WarmStart warm) override {
     if (record_.q.size() == 0) {
       record_.q = q.values();
       record_.lower = lower;
@@ -1085,7 +1087,7 @@ class RecordingKernels final : public compute::AdmmKernels {
       record_.x = x.size() > 0 ? x.values() : Eigen::MatrixXd();
       record_.y = y;
     }
-    inner_->start(q, lower, upper, x, y);
+    inner_->start(q, lower, upper, x, y, warm);
   }
   void setRelaxation(double alpha) override { inner_->setRelaxation(alpha); }
   void iterate(int count) override { inner_->iterate(count); }
@@ -1189,6 +1191,52 @@ TEST_F(VulkanAdmm, EqualityRowsKeepTheHostIterationWithTheDefaultInnerTolerance)
   relativeOnly.linearToleranceFraction = 1e30;
   const AdmmRun drifting = runAdmm(context(), recorder.qp, relativeOnly, kRecordings[1]);
   EXPECT_GT(drifting.info.iterations, host.info.iterations) << "the bound made no difference on this QP";
+}
+
+TEST_F(VulkanAdmm, AWarmStartedExactStepKeepsTheHostIterationWithItsIterateOnTheDevice) {
+  // A loop's next exact step (the same rows, nearby targets) from the iterate and rho the
+  // last one left where the kernels keep them (projective::BoxQpSettings::
+  // warmStartEqualities, compute::WarmStart::Kept: nothing crosses): the host's iteration
+  // and polished solution, in fewer iterations than from the targets and zero multipliers.
+  // A measurement in between (violationAt, which starts the kernels at the targets) keeps
+  // the iterate.
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
+  const BoxQp& qp = recorder.qp;
+  const Eigen::MatrixXd nearby = qp.q * 1.01;
+  const compute::RelaxedBounds bounds{qp.lower, std::vector<char>(qp.lower.rows(), 1), 0.0};
+  struct Next {
+    projective::BoxQpInfo info;
+    Eigen::MatrixXd x;
+  };
+  const auto nextStep = [&](compute::Backend& backend, bool warm) {
+    projective::BoxQpSettings settings;
+    settings.preconditionerBlock = 4;
+    settings.preconditioner = compute::AdmmPreconditioner::BlockJacobi;
+    settings.linearSolver.relativeTolerance = 1e-12;
+    settings.equalitySolve = projective::EqualitySolve::Admm;  // the CPU's too
+    settings.warmStartEqualities = warm;
+    projective::BoxQpSolver solver(backend, qp.P, qp.C, settings);
+    Eigen::MatrixXd x = -qp.q, y;
+    EXPECT_TRUE(projective::isSolved(solver.solve(qp.q, qp.lower, qp.upper, x, y).status));
+    const compute::DeviceMatrix targets(Eigen::MatrixXd(-nearby));
+    EXPECT_GT(solver.violationAt(nearby, bounds, targets), 0.0);
+    Next next{{}, -nearby};
+    Eigen::MatrixXd yNext;
+    next.info = solver.solve(nearby, qp.lower, qp.upper, next.x, yNext);
+    EXPECT_TRUE(projective::isSolved(next.info.status));
+    return next;
+  };
+  compute::CpuBackend cpu;
+  const Next cold = nextStep(cpu, false);
+  const Next host = nextStep(cpu, true);
+  EXPECT_LT(host.info.iterations, cold.info.iterations);
+  EXPECT_LT(relativeDifference(host.x, cold.x), 1e-9);
+  const Next device = nextStep(backend(), true);
+  SCOPED_TRACE("iterations: cold " + std::to_string(cold.info.iterations) + ", host " +
+               std::to_string(host.info.iterations) + ", device " + std::to_string(device.info.iterations));
+  EXPECT_LE(std::abs(device.info.iterations - host.info.iterations), compute::AdmmSettings{}.checkInterval);
+  EXPECT_LT(relativeDifference(device.x, host.x), 1e-8);
 }
 
 TEST_F(VulkanAdmm, LongInnerSolvesEndTheIterationAtItsFirstConvergedIterate) {

@@ -149,6 +149,51 @@ TEST(BoxQp, AnAllEqualityAdmmSolveStartsAtTheInitialRhoNotTheCarriedOne) {
   EXPECT_LT((x - xFresh).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST(BoxQp, WarmStartedEqualitySolvesStartFromTheLastSolvedOnesIterateAndRho) {
+  // A loop's next exact step: the same rows, a nearby q. Started from the last solve's
+  // iterate (held by the ADMM's kernels) and rho, it needs fewer iterations to the same
+  // solution (measured 7 against 12); after a solve with an inequality row, or without the
+  // setting, it starts at the initial rho from the x and y given, as a fresh solver would.
+  const EqualityQp qp = consistentEqualityQp(12, 5, 3, 13);
+  const Eigen::MatrixXd nearby = qp.q * 1.01;
+  compute::CpuBackend backend;
+  BoxQpSettings settings;
+  settings.equalitySolve = EqualitySolve::Admm;
+  settings.checkInterval = 1;
+  Eigen::MatrixXd xFresh, yFresh;
+  const BoxQpInfo fresh = solveOnNewSolver(backend, {qp.P, qp.C, nearby, qp.d}, settings, xFresh, yFresh);
+  ASSERT_EQ(fresh.status, BoxQpStatus::Solved);
+
+  for (const bool warm : {false, true}) {
+    SCOPED_TRACE(warm ? "warm" : "cold");
+    settings.warmStartEqualities = warm;
+    BoxQpSolver solver(backend, qp.P, qp.C, settings);
+    Eigen::MatrixXd x, y;
+    const BoxQpInfo first = solver.solve(qp.q, qp.d, qp.d, x, y);
+    ASSERT_EQ(first.status, BoxQpStatus::Solved);
+    Eigen::MatrixXd xNext, yNext;
+    const BoxQpInfo next = solver.solve(nearby, qp.d, qp.d, xNext, yNext);
+    ASSERT_EQ(next.status, BoxQpStatus::Solved);
+    EXPECT_LT((xNext - xFresh).cwiseAbs().maxCoeff(), 1e-8);
+    if (warm) {
+      EXPECT_LE(10 * next.iterations, 6 * fresh.iterations);
+    } else {
+      EXPECT_EQ(next.iterations, fresh.iterations);
+    }
+
+    // A box row in between: the next exact solve starts as a fresh one.
+    Eigen::MatrixXd lower = qp.d, upper = qp.d;
+    lower.row(0).array() -= 10.0;
+    upper.row(0).array() += 10.0;
+    Eigen::MatrixXd xBox, yBox;
+    ASSERT_TRUE(isSolved(solver.solve(qp.q, lower, upper, xBox, yBox).status));
+    Eigen::MatrixXd xAfter, yAfter;
+    const BoxQpInfo after = solver.solve(nearby, qp.d, qp.d, xAfter, yAfter);
+    EXPECT_EQ(after.iterations, fresh.iterations);
+    EXPECT_LT((xAfter - xFresh).cwiseAbs().maxCoeff(), 1e-8);
+  }
+}
+
 TEST(BoxQp, AnAllEqualityAdmmSolveIsNotOverRelaxed) {
   // Its rows are stiff (rho c^2 >> 1 at the equality rows' rho): the iteration, the method
   // of multipliers there, shrinks their error by |1 - alpha| per iteration, 0.3 with

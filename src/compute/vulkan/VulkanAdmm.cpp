@@ -568,11 +568,11 @@ bool AdmmKernels::loadLinearTerm(const compute::DeviceMatrix& q) {
 }
 
 void AdmmKernels::start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-                        const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) {
+                        const compute::DeviceMatrix& x, const Eigen::MatrixXd& y, compute::WarmStart warm) {
   if (!loadLinearTerm(q)) return;
   workspace_->lower.upload(lower);
   workspace_->upper.upload(upper);
-  finishStart(q, x, y, false, 0.0);
+  finishStart(q, x, y, warm, false, 0.0);
 }
 
 void AdmmKernels::loadRelaxedBounds(const compute::RelaxedBounds& bounds) {
@@ -591,25 +591,49 @@ void AdmmKernels::loadRelaxedBounds(const compute::RelaxedBounds& bounds) {
 }
 
 void AdmmKernels::startRelaxed(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
-                               const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) {
+                               const compute::DeviceMatrix& x, const Eigen::MatrixXd& y, compute::WarmStart warm) {
   if (!loadLinearTerm(q)) return;
   loadRelaxedBounds(bounds);
-  finishStart(q, x, y, true, bounds.epsilon);
+  finishStart(q, x, y, warm, true, bounds.epsilon);
 }
 
 std::optional<double> AdmmKernels::violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                                                const compute::DeviceMatrix& x) {
   if (!loadLinearTerm(q)) return 0.0;
   loadRelaxedBounds(bounds);
-  finishStart(q, x, Eigen::MatrixXd(), true, 0.0);  // l = u = the centre
-  return boundViolation();
+  // A measurement, not a solve: an iterate held for a kept start (WarmStart::Kept) is set
+  // aside in the block's save slots, free between solves, and put back.
+  Workspace& w = *workspace_;
+  const bool held = w.iterateHeld;
+  LinearAlgebra& la = algebra_;
+  if (held) {
+    recordedOnce(w.setAside, context_, [&](Sequence& s) {
+      la.copy(s, w.x, w.xSaved);
+      la.copy(s, w.y, w.ySaved);
+    }).run();
+  }
+  finishStart(q, x, Eigen::MatrixXd(), compute::WarmStart::Given, true, 0.0);  // l = u = the centre
+  const double violation = boundViolation();
+  if (held) {
+    recordedOnce(w.putBack, context_, [&](Sequence& s) {
+      la.copy(s, w.xSaved, w.x);
+      la.copy(s, w.ySaved, w.y);
+    }).run();
+  }
+  w.iterateHeld = held;
+  return violation;
 }
 
 void AdmmKernels::finishStart(const compute::DeviceMatrix& q, const compute::DeviceMatrix& x, const Eigen::MatrixXd& y,
-                              bool relaxedBounds, double epsilon) {
+                              compute::WarmStart warm, bool relaxedBounds, double epsilon) {
   Workspace& w = *workspace_;
+  // A kept start keeps x and y where they are, once a start defined them (a new
+  // workspace's buffers hold garbage).
+  const bool keep = warm == compute::WarmStart::Kept && w.iterateHeld;
   StartX xStart = StartX::Uploaded;
-  if (x.size() == 0) {
+  if (keep) {
+    // x as it is: StartX::Uploaded records nothing for x, and nothing is uploaded.
+  } else if (x.size() == 0) {
     xStart = StartX::Zero;
   } else if (x.rows() == q.rows() && x.cols() == q.cols() && x.source() && x.source() == q.source() &&
              x.factor() == -q.factor()) {  // one device matrix and its negation
@@ -618,9 +642,10 @@ void AdmmKernels::finishStart(const compute::DeviceMatrix& q, const compute::Dev
              x.values() == -q.values()) {  // exact: negation rounds nothing
     xStart = StartX::NegatedQ;
   }
-  const bool zeroY = y.size() == 0;
-  if (xStart == StartX::Uploaded) w.x.upload(x.values());
-  if (!zeroY) w.y.upload(y);
+  const bool zeroY = !keep && y.size() == 0;
+  if (!keep && xStart == StartX::Uploaded) w.x.upload(x.values());
+  if (!keep && !zeroY) w.y.upload(y);
+  w.iterateHeld = true;
   double state[kStateSize] = {};
   state[kStateEpsilon] = epsilon;
   w.state.upload(state);

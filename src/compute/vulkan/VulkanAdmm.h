@@ -169,10 +169,11 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// A q that is minus a device matrix of the backend's resident ideal maps, and an x that is
   /// that matrix, are formed from the maps' array (no copy either way).
   void start(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
-             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override;
+             const compute::DeviceMatrix& x, const Eigen::MatrixXd& y, compute::WarmStart warm) override;
   void startRelaxed(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
-                    const compute::DeviceMatrix& x, const Eigen::MatrixXd& y) override;
-  /// startRelaxed with epsilon 0, then boundViolation(): one check-sized read.
+                    const compute::DeviceMatrix& x, const Eigen::MatrixXd& y, compute::WarmStart warm) override;
+  /// startRelaxed with epsilon 0, then boundViolation(): one check-sized read. The iterate
+  /// held for a kept start (WarmStart::Kept) stays: a measurement is not a solve.
   std::optional<double> violationAt(const compute::DeviceMatrix& q, const compute::RelaxedBounds& bounds,
                                     const compute::DeviceMatrix& x) override;
   void setRelaxation(double alpha) override { relaxation_ = alpha; }
@@ -234,7 +235,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// from that column's active sides (shaders/admm_active_flags.comp).
   void assembleK1FromRowScales(int sidesColumn);
   void assembleK(double rho);
-  /// How start() sets x: uploaded, zero, or -q (each formed on the device but the first).
+  /// How start() sets x: uploaded (or the held one kept), zero, or -q (each formed on the
+  /// device but the first).
   enum class StartX { Uploaded, Zero, NegatedQ };
   /// Both starts' first part: the workspace for q's columns, and q (false: no columns,
   /// nothing to start).
@@ -245,7 +247,7 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// Both starts' last part, after the bounds: the warm starts (uploaded or formed as StartX
   /// says), the state (with a relaxation's epsilon) and the start recording.
   void finishStart(const compute::DeviceMatrix& q, const compute::DeviceMatrix& x, const Eigen::MatrixXd& y,
-                   bool relaxedBounds, double epsilon);
+                   compute::WarmStart warm, bool relaxedBounds, double epsilon);
   /// z = clamp(C x, l, u), xTilde = x, yPrevious = y, after setting x (StartX), zeroing y
   /// and forming relaxed bounds as asked.
   void recordStart(Sequence& s, StartX xStart, bool zeroY, bool relaxedBounds);

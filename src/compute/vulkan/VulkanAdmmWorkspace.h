@@ -223,6 +223,10 @@ struct AdmmKernels::Workspace {
   };
   std::unique_ptr<Polish> polish;
   bool polishStartSaved = false;
+  /// x and y hold an iterate a start defined (WarmStart::Kept keeps it), not a new buffer's contents.
+  bool iterateHeld = false;
+  /// violationAt's: x, y to xSaved, ySaved and back (recorded on first use).
+  std::unique_ptr<Sequence> setAside, putBack;
   bool relaxedStart = false;  ///< The last start formed l and u from w.centre and w.relaxed.
   Eigen::MatrixXd uploadedQ;  ///< What w.q holds (start() skips an equal q's upload).
   /// The resident maps' generation whose -T w.q holds (0: none; uploadedQ is then what it holds).
