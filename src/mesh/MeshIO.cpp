@@ -1,8 +1,6 @@
 #include "mesh/MeshIO.h"
 
 #include <fcntl.h>
-#include <pthread.h>
-#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "core/DeferredSignals.h"
 #include "core/Error.h"
 #include "mesh/io/ObjFormat.h"
 #include "mesh/io/OffFormat.h"
@@ -118,32 +117,8 @@ void writeMesh(const std::filesystem::path& path, const PolygonMesh& mesh, const
   writeFileAtomically(path, formatMesh(mesh, format, options));
 }
 
-namespace {
-
-/// Blocks SIGINT and SIGTERM in this thread for its lifetime. The plano tool's first Ctrl-C
-/// only sets a flag, but a second one kills the process: deferred to the end of an atomic
-/// write, it cannot leave the temporary file behind or the target half-replaced.
-class InterruptionsDeferred {
- public:
-  InterruptionsDeferred() {
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals, &previous_);
-  }
-  ~InterruptionsDeferred() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
-  InterruptionsDeferred(const InterruptionsDeferred&) = delete;
-  InterruptionsDeferred& operator=(const InterruptionsDeferred&) = delete;
-
- private:
-  sigset_t previous_;
-};
-
-}  // namespace
-
 void writeFileAtomically(const std::filesystem::path& path, const std::string& content) {
-  const InterruptionsDeferred deferred;
+  const DeferredSignals deferred;
   const std::filesystem::path target = std::filesystem::absolute(path);
   std::error_code ec;
   if (std::filesystem::is_directory(target, ec)) throwBadInput(path.string() + ": is a directory");

@@ -1,8 +1,6 @@
 #include "plano/OutputGuard.h"
 
 #include <fcntl.h>
-#include <pthread.h>
-#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,6 +11,7 @@
 #include <random>
 
 #include "core/Cancellation.h"
+#include "core/DeferredSignals.h"
 #include "core/Error.h"
 #include "mesh/MeshIO.h"
 
@@ -124,32 +123,6 @@ OutputTarget resolveOutput(const std::string& path) {
 
 namespace {
 
-/// Blocks SIGINT and SIGTERM in this thread while it lives. The tool's first Ctrl-C only
-/// sets a flag, but a second one kills the process: deferred, it cannot leave temporary
-/// files behind or some targets replaced and others not. poll() lets a pending signal in
-/// (its handler sets the flag) between two pieces of work.
-class SignalsDeferred {
- public:
-  SignalsDeferred() {
-    sigemptyset(&signals_);
-    sigaddset(&signals_, SIGINT);
-    sigaddset(&signals_, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals_, &previous_);
-  }
-  ~SignalsDeferred() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
-  SignalsDeferred(const SignalsDeferred&) = delete;
-  SignalsDeferred& operator=(const SignalsDeferred&) = delete;
-
-  void poll() {
-    pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
-    pthread_sigmask(SIG_BLOCK, &signals_, nullptr);
-  }
-
- private:
-  sigset_t signals_;
-  sigset_t previous_;
-};
-
 /// Write all of `content` to `fd`, in pieces between which `between` runs; false with errno
 /// set when a write fails.
 template <typename Between>
@@ -187,7 +160,7 @@ void OutputFiles::commit() {
   for (const File& file : files_) targets.push_back(resolveOutput(file.path));
   std::vector<std::filesystem::path> temporaries(files_.size());
   {
-    SignalsDeferred deferred;
+    DeferredSignals deferred;
     const auto removeTemporaries = [&] {
       std::error_code ignored;
       for (const auto& temp : temporaries) {
