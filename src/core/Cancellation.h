@@ -39,4 +39,11 @@ inline void throwIfCancelled(const char* where) {
   if (cancellationRequested()) throw Interrupted(std::string("stopped during ") + where);
 }
 
+/// throwIfCancelled at every 65536th index of a loop whose body is too cheap to poll each
+/// time (formatting a file, generating or measuring a mesh): over millions of elements such
+/// a loop takes seconds, and a Ctrl-C should not wait for it.
+inline void throwIfCancelledAt(long long index, const char* where) {
+  if ((index & 0xFFFF) == 0) throwIfCancelled(where);
+}
+
 }  // namespace plano

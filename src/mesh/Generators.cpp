@@ -6,6 +6,7 @@
 #include <map>
 #include <numbers>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace plano::generate {
@@ -21,6 +22,7 @@ FaceList gridFaces(Index nu, Index nv, bool wrapU) {
   const Index uVertices = wrapU ? nu : nu + 1;
   faces.reserve(static_cast<std::size_t>(nu) * nv, static_cast<std::size_t>(nu) * nv * 4);
   for (Index i = 0; i < nu; ++i) {
+    throwIfCancelled("generating the mesh");
     const Index i1 = (i + 1) % uVertices;
     for (Index j = 0; j < nv; ++j) {
       faces.addFace({i * rows + j, i1 * rows + j, i1 * rows + j + 1, i * rows + j + 1});
@@ -43,6 +45,7 @@ PolygonMesh translationalSurface(Index nu, Index nv, double amplitude) {
   PolygonMesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(nu + 1) * (nv + 1), 3);
   for (Index i = 0; i <= nu; ++i) {
+    throwIfCancelled("generating the mesh");
     const double u = static_cast<double>(i) / nu;
     const Eigen::Vector3d a(u, 0.0, amplitude * std::sin(kPi * u));
     for (Index j = 0; j <= nv; ++j) {
@@ -148,6 +151,7 @@ struct Lattice {
 Lattice hexLattice(Index R) {
   Lattice lattice;
   for (Index q = -R; q <= R; ++q) {
+    throwIfCancelled("generating the mesh");
     for (Index r = -R; r <= R; ++r) {
       if (std::abs(q + r) > R) continue;
       lattice.index[{q, r}] = static_cast<Index>(lattice.coords.size());
@@ -168,7 +172,9 @@ PolygonMesh hexagonsFromLattice(Index rings, VertexOf vertexOf) {
   std::map<std::array<Index, 3>, Index> triangleVertex;
   std::vector<Eigen::Vector3d> points;
   PolygonMesh mesh;
+  long long point = 0;
   for (const auto& [q, r] : lattice.coords) {
+    throwIfCancelledAt(point++, "generating the mesh");
     if (std::abs(q) >= R || std::abs(r) >= R || std::abs(q + r) >= R) continue;  // boundary point
     const Index centre = lattice.index.at({q, r});
     std::vector<Index> face;

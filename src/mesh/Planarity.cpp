@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/Cancellation.h"
+
 namespace plano {
 
 double quadPlanarity(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
@@ -95,6 +97,7 @@ PlanarityStats planarityStats(const PolygonMesh& mesh, double tolerance) {
   double maxRun = 0.0;
   double maxResidual = 0.0;
   for (Index f = 0; f < mesh.faceCount(); ++f) {
+    throwIfCancelledAt(f, "measuring planarity");
     const FacePlanarity p = facePlanarity(mesh.vertices, mesh.faces[f]);
     values[f] = p.mean;
     maxRun = std::max(maxRun, p.max);

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
+#include "mesh/MeshIO.h"
 #include "mesh/Planarity.h"
 
 namespace plano {
@@ -65,6 +67,32 @@ TEST(Generators, UnknownKindIsAUsageError) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Usage);
     EXPECT_NE(std::string(e.what()).find("klein-bottle"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace plano
+
+namespace plano {
+namespace {
+
+/// Clears a cancellation request when the test ends, whatever happens in it.
+struct CancellationRequested {
+  CancellationRequested() { requestCancellation(); }
+  ~CancellationRequested() { clearCancellation(); }
+};
+
+TEST(Generators, GeneratingMeasuringAndFormattingAMeshStopAtARequestedCancellation) {
+  // Loops over millions of elements take seconds each (plano generate -n 3000): a Ctrl-C
+  // is looked at inside them, not after them.
+  const PolygonMesh mesh = generate::translationalSurface(4, 4);
+  const PolygonMesh hexagons = generate::hexagonalPlane(2);
+  const CancellationRequested cancelled;
+  EXPECT_THROW(generate::translationalSurface(4, 4), Interrupted);
+  EXPECT_THROW(generate::hexagonalPlane(2), Interrupted);
+  EXPECT_THROW(planarityStats(mesh), Interrupted);
+  for (const MeshFormat format : {MeshFormat::Obj, MeshFormat::Off, MeshFormat::Ply}) {
+    EXPECT_THROW(formatMesh(hexagons, format), Interrupted) << static_cast<int>(format);
   }
 }
 

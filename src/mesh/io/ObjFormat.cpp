@@ -169,6 +169,7 @@ std::string formatObj(const PolygonMesh& mesh) {
   out.reserve(static_cast<std::size_t>(mesh.vertexCount()) * 60 +
               static_cast<std::size_t>(mesh.faces.cornerCount()) * 8);
   for (Index v = 0; v < mesh.vertexCount(); ++v) {
+    throwIfCancelledAt(v, "writing the mesh");
     out += "v";
     for (int a = 0; a < 3; ++a) {
       out += ' ';
@@ -177,6 +178,7 @@ std::string formatObj(const PolygonMesh& mesh) {
     out += '\n';
   }
   for (Index f = 0; f < mesh.faceCount(); ++f) {
+    throwIfCancelledAt(f, "writing the mesh");
     out += "f";
     for (Index v : mesh.faces[f]) {
       out += ' ';

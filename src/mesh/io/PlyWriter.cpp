@@ -43,9 +43,11 @@ std::string formatPly(const PolygonMesh& mesh, PlyEncoding encoding) {
   out.reserve(out.size() + static_cast<std::size_t>(mesh.vertexCount()) * 24 +
               static_cast<std::size_t>(mesh.faceCount()) * 4 + static_cast<std::size_t>(mesh.faces.cornerCount()) * 4);
   for (Index v = 0; v < mesh.vertexCount(); ++v) {
+    throwIfCancelledAt(v, "writing the mesh");
     for (int a = 0; a < 3; ++a) appendBinary(out, mesh.vertices(v, a), big);
   }
   for (Index f = 0; f < mesh.faceCount(); ++f) {
+    throwIfCancelledAt(f, "writing the mesh");
     if (wideCounts) {
       appendBinary(out, static_cast<std::int32_t>(mesh.faces.degree(f)), big);
     } else {

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "mesh/PolygonMesh.h"
 
 namespace plano::io {
@@ -25,6 +26,7 @@ inline void appendInteger(std::string& out, long long value) {
 /// "degree v0 v1 ..." per face (0-based indices).
 inline void appendVertexAndFaceLines(std::string& out, const PolygonMesh& mesh) {
   for (Index v = 0; v < mesh.vertexCount(); ++v) {
+    throwIfCancelledAt(v, "writing the mesh");
     for (int a = 0; a < 3; ++a) {
       if (a) out += ' ';
       appendDouble(out, mesh.vertices(v, a));
@@ -32,6 +34,7 @@ inline void appendVertexAndFaceLines(std::string& out, const PolygonMesh& mesh) 
     out += '\n';
   }
   for (Index f = 0; f < mesh.faceCount(); ++f) {
+    throwIfCancelledAt(f, "writing the mesh");
     appendInteger(out, mesh.faces.degree(f));
     for (Index v : mesh.faces[f]) {
       out += ' ';
