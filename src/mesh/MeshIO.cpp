@@ -1,17 +1,12 @@
 #include "mesh/MeshIO.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
-#include <random>
 
 #include "core/DeferredSignals.h"
 #include "core/Error.h"
+#include "core/StagedFile.h"
 #include "mesh/io/ObjFormat.h"
 #include "mesh/io/OffFormat.h"
 #include "mesh/io/PlyFormat.h"
@@ -122,44 +117,9 @@ void writeFileAtomically(const std::filesystem::path& path, const std::string& c
   const std::filesystem::path target = std::filesystem::absolute(path);
   std::error_code ec;
   if (std::filesystem::is_directory(target, ec)) throwBadInput(path.string() + ": is a directory");
-  std::random_device rd;
-  // Built by appending: GCC 12 warns falsely (-Wrestrict) on "." + string.
-  std::string name = ".";
-  name += target.filename().string();
-  name += ".tmp" + std::to_string(getpid()) + "-" + std::to_string(rd());
-  const std::filesystem::path temp = target.parent_path() / name;
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    throwBadInput(path.string() + ": cannot write (" + std::strerror(errno) + ")");
-  }
-  auto abandon = [&](const std::string& why) {
-    ::close(fd);
-    std::filesystem::remove(temp, ec);
-    throwBadInput(path.string() + ": " + why);
-  };
-  const char* data = content.data();
-  std::size_t left = content.size();
-  while (left > 0) {
-    const ssize_t written = ::write(fd, data, left);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      abandon(std::string("write failed (") + std::strerror(errno) + ")");
-    }
-    data += written;
-    left -= static_cast<std::size_t>(written);
-  }
-  // On disk before the rename, so that a crash cannot leave an empty file in place of the old one.
-  if (::fsync(fd) != 0) abandon(std::string("write failed (") + std::strerror(errno) + ")");
-  if (::close(fd) != 0) {
-    std::filesystem::remove(temp, ec);
-    throwBadInput(path.string() + ": write failed (" + std::strerror(errno) + ")");
-  }
-  std::filesystem::rename(temp, target, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    throwBadInput(path.string() + ": cannot replace file: " + ec.message());
-  }
+  StagedFile file(target, path.string());
+  file.write(content);
+  file.commit();
 }
 
 }  // namespace plano

@@ -8,11 +8,12 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <random>
+#include <memory>
 
 #include "core/Cancellation.h"
 #include "core/DeferredSignals.h"
 #include "core/Error.h"
+#include "core/StagedFile.h"
 #include "mesh/MeshIO.h"
 
 namespace plano::cli {
@@ -123,16 +124,13 @@ OutputTarget resolveOutput(const std::string& path) {
 
 namespace {
 
-/// Write all of `content` to `fd`, in pieces between which `between` runs; false with errno
-/// set when a write fails.
-template <typename Between>
-bool writeAll(int fd, const std::string& content, Between between) {
-  constexpr std::size_t kPiece = std::size_t{16} << 20;
+/// Write all of `content` to the stream `fd` (a FIFO or device); false with errno set when a
+/// write fails.
+bool writeAll(int fd, const std::string& content) {
   const char* data = content.data();
   std::size_t left = content.size();
   while (left > 0) {
-    between();
-    const ssize_t written = ::write(fd, data, std::min(left, kPiece));
+    const ssize_t written = ::write(fd, data, left);
     if (written < 0) {
       if (errno == EINTR) continue;
       return false;
@@ -143,14 +141,6 @@ bool writeAll(int fd, const std::string& content, Between between) {
   return true;
 }
 
-std::filesystem::path temporaryNextTo(const std::filesystem::path& target) {
-  std::random_device random;
-  std::string name = ".";
-  name += target.filename().string();
-  name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(random());
-  return target.parent_path() / name;
-}
-
 }  // namespace
 
 void OutputFiles::add(std::string path, std::string content) { files_.push_back({std::move(path), std::move(content)}); }
@@ -158,64 +148,30 @@ void OutputFiles::add(std::string path, std::string content) { files_.push_back(
 void OutputFiles::commit() {
   std::vector<OutputTarget> targets;
   for (const File& file : files_) targets.push_back(resolveOutput(file.path));
-  std::vector<std::filesystem::path> temporaries(files_.size());
   {
     DeferredSignals deferred;
-    const auto removeTemporaries = [&] {
-      std::error_code ignored;
-      for (const auto& temp : temporaries) {
-        if (!temp.empty()) std::filesystem::remove(temp, ignored);
-      }
-    };
     const auto between = [&] {
       if (!interruptible_) return;
       deferred.poll();
-      if (cancellationRequested()) {
-        removeTemporaries();
-        throw Interrupted("stopped during writing the results");
-      }
+      if (cancellationRequested()) throw Interrupted("stopped during writing the results");
     };
+    // Every regular file complete on disk before any is renamed; an exception removes the
+    // temporary files written so far (StagedFile's destructor).
+    std::vector<std::unique_ptr<StagedFile>> staged;
     for (std::size_t i = 0; i < files_.size(); ++i) {
       if (targets[i].stream) continue;
-      const std::filesystem::path temp = temporaryNextTo(targets[i].path);
-      const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-      if (fd < 0) {
-        const std::string why = std::strerror(errno);
-        removeTemporaries();
-        throwBadInput(files_[i].path + ": cannot write (" + why + ")");
-      }
-      temporaries[i] = temp;
-      // On disk before the rename, so that a crash cannot leave an empty file in place of the old one.
-      if (!writeAll(fd, files_[i].content, between) || ::fsync(fd) != 0) {
-        const std::string why = std::strerror(errno);
-        ::close(fd);
-        removeTemporaries();
-        throwBadInput(files_[i].path + ": write failed (" + why + ")");
-      }
-      if (::close(fd) != 0) {
-        const std::string why = std::strerror(errno);
-        removeTemporaries();
-        throwBadInput(files_[i].path + ": write failed (" + why + ")");
-      }
+      staged.push_back(std::make_unique<StagedFile>(targets[i].path, files_[i].path));
+      staged.back()->write(files_[i].content, between);
     }
     between();
-    for (std::size_t i = 0; i < files_.size(); ++i) {
-      if (temporaries[i].empty()) continue;
-      std::error_code ec;
-      std::filesystem::rename(temporaries[i], targets[i].path, ec);
-      if (ec) {
-        removeTemporaries();
-        throwBadInput(files_[i].path + ": cannot replace the file: " + ec.message());
-      }
-      temporaries[i].clear();
-    }
+    for (const auto& file : staged) file->commit();
   }
   // Streams last, with signals let in: opening a FIFO waits for its reader, and Ctrl-C must
   // still end a run that waits for one that never comes.
   for (std::size_t i = 0; i < files_.size(); ++i) {
     if (!targets[i].stream) continue;
     const int fd = ::open(targets[i].path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
-    if (fd < 0 || !writeAll(fd, files_[i].content, [] {})) {
+    if (fd < 0 || !writeAll(fd, files_[i].content)) {
       const std::string why = std::strerror(errno);
       if (fd >= 0) ::close(fd);
       throwBadInput(files_[i].path + ": write failed (" + why + ")");
