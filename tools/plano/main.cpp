@@ -125,13 +125,7 @@ namespace {
 /// passes every "> 0" check, and a NaN or Inf weight, tolerance, amplitude or coordinate
 /// would otherwise run (or fail as a numerical error) instead of being a usage error.
 void requireFiniteFloatOptions(CLI::App& app) {
-  const CLI::Validator finite(
-      [](std::string& text) -> std::string {
-        double value = 0.0;
-        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value)) return "must be finite (got " + text + ")";
-        return {};
-      },
-      "");
+  const CLI::Validator finite = numberCheck([](double) { return std::string(); }, "");
   for (CLI::Option* option : app.get_options()) {
     if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
   }
