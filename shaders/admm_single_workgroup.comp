@@ -20,6 +20,13 @@
 // vectors read across rows (p in K p, xTilde in C xTilde, z and y in C^T (rho z - y))
 // need a buffer barrier after they are written. Dot products reduce in shared memory.
 // Vectors are column-major (n x k or m x k).
+//
+// The preconditioner is either the blocks' dense b x b inverses (block-Jacobi) or, with
+// `dense` set, K's whole dense n x n inverse (the automatic choice on the smallest K, where
+// it makes every solve about one PCG iteration: vk::AdmmKernels::kMaxWholeInverseBlocks).
+// Its product reads r across rows, which then needs a barrier between forming r and
+// preconditioning it; the right-hand side of a solve's start is kept in kp for the same
+// reason (kp is free until the solve's first K p).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
@@ -34,7 +41,8 @@ layout(local_size_x_id = 0) in;
 layout(std430, binding = 0) readonly buffer KRows { int kRows[]; };
 layout(std430, binding = 1) readonly buffer KColumns { int kColumns[]; };
 layout(std430, binding = 2) readonly buffer KValues { double kValues[]; };
-// n / b dense b x b inverse blocks of K (row-major): the block-Jacobi preconditioner.
+// n / b dense b x b inverse blocks of K (row-major): the block-Jacobi preconditioner; with
+// `dense`, K's whole inverse (n x n, row-major).
 layout(std430, binding = 3) readonly buffer InverseBlocks { double inverseBlocks[]; };
 layout(std430, binding = 4) readonly buffer CRows { int cRows[]; };
 layout(std430, binding = 5) readonly buffer CColumns { int cColumns[]; };
@@ -45,10 +53,10 @@ layout(std430, binding = 9) readonly buffer CtValues { double ctValues[]; };
 layout(std430, binding = 10) readonly buffer Q { double q[]; };
 layout(std430, binding = 11) buffer X { double x[]; };
 layout(std430, binding = 12) coherent buffer XTilde { double xTilde[]; };
-layout(std430, binding = 13) buffer R { double r[]; };
+layout(std430, binding = 13) coherent buffer R { double r[]; };
 layout(std430, binding = 14) buffer Zp { double zp[]; };  // preconditioned residual
 layout(std430, binding = 15) coherent buffer P { double p[]; };
-layout(std430, binding = 16) buffer Kp { double kp[]; };
+layout(std430, binding = 16) coherent buffer Kp { double kp[]; };
 layout(std430, binding = 17) readonly buffer Lower { double lower[]; };
 layout(std430, binding = 18) readonly buffer Upper { double upper[]; };
 layout(std430, binding = 19) coherent buffer Y { double y[]; };
@@ -79,6 +87,8 @@ layout(push_constant) uniform Push {
   uint budget;      // units of work of this dispatch
   uint begin;       // 1: this dispatch starts the block (else it resumes from state)
   uint b;           // preconditioner block size: divides n, at most MAX_BLOCK
+  uint dense;       // 1: inverseBlocks is K's whole inverse (above)
+  uint unused;
   double sigma;
   double alpha;       // over-relaxation
   double tolerance2;  // relative: PCG stops when r.z <= tolerance2 * b.z (and ||r|| is small)
@@ -126,11 +136,36 @@ void synchronize() {
   barrier();
 }
 
+// Row i of K's whole inverse times column c of v (r or, at a solve's start, the
+// right-hand side kept in kp): every invocation's writes of v must be visible. Four
+// entries per loop pass: a row is n entries, and on lavapipe every pass counts against an
+// invocation's loop limit (above; vk::AdmmKernels::singleWorkgroupBudget).
+double wholeInverseRow(uint i, uint c, bool ofRightHandSide) {
+  const uint n = pc.n, row = i * n, column = c * n;
+  double sum = 0.0;
+  uint u = 0;
+  if (ofRightHandSide) {
+    for (; u + 4 <= n; u += 4) {
+      sum += inverseBlocks[row + u] * kp[column + u] + inverseBlocks[row + u + 1] * kp[column + u + 1] +
+             inverseBlocks[row + u + 2] * kp[column + u + 2] + inverseBlocks[row + u + 3] * kp[column + u + 3];
+    }
+    for (; u < n; ++u) sum += inverseBlocks[row + u] * kp[column + u];
+  } else {
+    for (; u + 4 <= n; u += 4) {
+      sum += inverseBlocks[row + u] * r[column + u] + inverseBlocks[row + u + 1] * r[column + u + 1] +
+             inverseBlocks[row + u + 2] * r[column + u + 2] + inverseBlocks[row + u + 3] * r[column + u + 3];
+    }
+    for (; u < n; ++u) sum += inverseBlocks[row + u] * r[column + u];
+  }
+  return sum;
+}
+
 void main() {
   const uint lane = gl_LocalInvocationID.x;
   const uint n = pc.n;
   const uint m = pc.m;
   const uint blocks = n / pc.b;
+  const bool dense = pc.dense != 0;
   uint remaining = pc.begin != 0 ? pc.iterations : uint(state[STATE_REMAINING]);
   uint phase = pc.begin != 0 ? 0 : uint(state[STATE_PHASE]);
   uint j = uint(state[STATE_SOLVE_ITERATIONS]);
@@ -175,7 +210,9 @@ void main() {
             rhsBlock[t] = rhs;
             residual[t] = rhs - product;
             r[c * n + i] = residual[t];
+            if (dense) kp[c * n + i] = rhs;
           }
+          if (dense) continue;  // preconditioned below, once r is whole
           for (uint t = 0; t < pc.b; ++t) {
             const uint i = block * pc.b + t;
             double zi = 0.0, mb = 0.0;
@@ -189,6 +226,22 @@ void main() {
             rz[c] += residual[t] * zi;
             bz[c] += rhsBlock[t] * mb;
             rr[c] += residual[t] * residual[t];
+          }
+        }
+      }
+      if (dense) {
+        synchronize();  // r and the right-hand side
+        for (uint block = lane; block < blocks; block += GROUP) {
+          for (uint i = block * pc.b; i < (block + 1) * pc.b; ++i) {
+            for (uint c = 0; c < pc.k; ++c) {
+              const double zi = wholeInverseRow(i, c, false);
+              const double residual = r[c * n + i];
+              zp[c * n + i] = zi;
+              p[c * n + i] = zi;
+              rz[c] += residual * zi;
+              bz[c] += kp[c * n + i] * wholeInverseRow(i, c, true);
+              rr[c] += residual * residual;
+            }
           }
         }
       }
@@ -241,12 +294,27 @@ void main() {
             residual[t] = r[c * n + i] - a * kp[c * n + i];
             r[c * n + i] = residual[t];
           }
+          if (dense) continue;  // preconditioned below, once r is whole
           for (uint t = 0; t < pc.b; ++t) {
             double zi = 0.0;
             for (uint u = 0; u < pc.b; ++u) zi += inverseBlocks[(block * pc.b + t) * pc.b + u] * residual[u];
             zp[c * n + block * pc.b + t] = zi;
             rzNext[c] += residual[t] * zi;
             rr[c] += residual[t] * residual[t];
+          }
+        }
+      }
+      if (dense) {
+        synchronize();  // r
+        for (uint block = lane; block < blocks; block += GROUP) {
+          for (uint i = block * pc.b; i < (block + 1) * pc.b; ++i) {
+            for (uint c = 0; c < pc.k; ++c) {
+              const double zi = wholeInverseRow(i, c, false);
+              const double residual = r[c * n + i];
+              zp[c * n + i] = zi;
+              rzNext[c] += residual * zi;
+              rr[c] += residual * residual;
+            }
           }
         }
       }

@@ -1365,7 +1365,8 @@ TEST_F(VulkanAdmm, MultigridPreconditionerKeepsTheHostIterationWithFewerPcgItera
 TEST_F(VulkanAdmm, AutomaticPreconditionerIsKsWholeInverseUpTo128FacesAndTheCycleAbove) {
   // 64 faces (the cycle's coarsest target: once face blocks in the single-workgroup
   // recording) and 100: K's whole inverse, one level; 144: the two-level cycle. The
-  // single-workgroup recording has no cycle and keeps face blocks.
+  // single-workgroup recording applies the whole inverse itself but has no cycle: above
+  // 128 faces it keeps face blocks.
   for (const auto& [side, levels] : {std::pair<Index, int>{8, 1}, {10, 1}, {12, 2}}) {
     SCOPED_TRACE(side * side);
     RecordingBackend recorder;
@@ -1376,8 +1377,38 @@ TEST_F(VulkanAdmm, AutomaticPreconditionerIsKsWholeInverseUpTo128FacesAndTheCycl
     EXPECT_TRUE(automatic.multigrid());
     EXPECT_EQ(automatic.multigridLevels(), levels);
     const vk::AdmmKernels single(context(), recorder.qp.P, recorder.qp.C, settings, vk::AdmmRecording::SingleWorkgroup);
-    EXPECT_FALSE(single.multigrid()) << "the single-workgroup kernel has no cycle";
+    EXPECT_EQ(single.multigridLevels(), levels == 1 ? 1 : 0);
   }
+}
+
+TEST_F(VulkanAdmm, TheSingleWorkgroupKernelAppliesKsWholeInverseAsTheMultiDispatchPcgDoes) {
+  // A 64-face global step: K's whole inverse in the multi-dispatch PCG (one cycle of one
+  // level per iteration) and in the single-workgroup kernel (its own dense product after
+  // a barrier), also resuming after every unit of work. The same ADMM iterations, about
+  // one PCG iteration per solve, and the same solution up to the rounding of the solves.
+  RecordingBackend recorder;
+  ASSERT_NO_FATAL_FAILURE(captureGlobalStepQp(8, recorder));
+  const compute::AdmmSettings settings = recorder.settingsUsed;
+  ASSERT_EQ(settings.preconditioner, compute::AdmmPreconditioner::Automatic);
+  const AdmmRun multiDispatch = runAdmm(context(), recorder.qp, settings, kRecordings[0]);
+  ASSERT_EQ(multiDispatch.info.status, compute::AdmmStatus::Solved);
+  for (const Recording& recording : {kRecordings[1], kResumingEveryUnit}) {
+    SCOPED_TRACE(recording.name);
+    const AdmmRun single = runAdmm(context(), recorder.qp, settings, recording);
+    EXPECT_EQ(single.info.status, compute::AdmmStatus::Solved);
+    EXPECT_EQ(single.info.iterations, multiDispatch.info.iterations);
+    EXPECT_LE(single.info.linearIterations, 3L * single.info.iterations) << "the preconditioner is K's inverse";
+    EXPECT_LT(relativeDifference(single.x, multiDispatch.x), 1e-8);
+  }
+
+  // The automatic recording runs it in one workgroup.
+  vk::AdmmKernels automatic(context(), recorder.qp.P, recorder.qp.C, settings);
+  const Index n = recorder.qp.P.rows(), m = recorder.qp.C.rows(), k = recorder.qp.q.cols();
+  automatic.setRho(std::vector<char>(m, 0), settings.rho);
+  automatic.start(recorder.qp.q, recorder.qp.lower, recorder.qp.upper, Eigen::MatrixXd::Zero(n, k),
+                  Eigen::MatrixXd::Zero(m, k), compute::WarmStart::Given);
+  EXPECT_EQ(automatic.multigridLevels(), 1);
+  EXPECT_TRUE(automatic.singleWorkgroup());
 }
 
 TEST_F(VulkanAdmm, AutomaticMultigridInvertsAKOfAtMost128FacesWholeAndSolvesInAboutOnePcgIterationPerSolve) {

@@ -196,11 +196,13 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
   algebra_.gatherSum(valuesUpdate_, *transpose_, devC_.values(), devCt_.values());
   valuesUpdate_.end();
   const compute::BlockMultigridSettings multigridSettings{static_cast<int>(block_)};
-  // Automatic: the cycle, or K's whole inverse where K is small (below); both need the
-  // multi-dispatch recording, so an explicit single-workgroup one keeps face blocks.
+  // Automatic: the cycle, or K's whole inverse where K is small (below). The
+  // single-workgroup kernel applies the whole inverse but records no cycle, so an explicit
+  // single-workgroup recording of a larger K keeps face blocks.
+  const bool automatic = settings_.preconditioner == compute::AdmmPreconditioner::Automatic;
+  const bool wholeInverse = automatic && static_cast<Index>(n_ / block_) <= kMaxWholeInverseBlocks;
   const bool multigrid = settings_.preconditioner == compute::AdmmPreconditioner::Multigrid ||
-                         (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
-                          recording_ != AdmmRecording::SingleWorkgroup);
+                         (automatic && (recording_ != AdmmRecording::SingleWorkgroup || wholeInverse));
   if (settings_.preconditioner == compute::AdmmPreconditioner::Multigrid &&
       recording_ == AdmmRecording::SingleWorkgroup) {
     throwUsage("ADMM: the multigrid preconditioner runs only in the multi-dispatch recording");
@@ -224,10 +226,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     // deformation's global step, 30 ADMM iterations: 104 s with 60 PCG iterations, 21.8 s
     // with the two-level cycle's 3 961).
     compute::BlockMultigridSettings aggregationSettings = multigridSettings;
-    if (settings_.preconditioner == compute::AdmmPreconditioner::Automatic &&
-        static_cast<Index>(n_ / block_) <= kMaxWholeInverseBlocks) {
-      aggregationSettings.coarsestBlocks = kMaxCoarsestBlocks;
-    }
+    if (wholeInverse) aggregationSettings.coarsestBlocks = kMaxCoarsestBlocks;
     aggregation_ = std::make_unique<compute::BlockAggregation>(compute::SparseMatrix(K0_ + CtC), aggregationSettings);
     // Coarsening stalls where K couples few blocks (say, faces without shared vertices);
     // the coarsest level is then too large for its dense inverse.
@@ -239,6 +238,8 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
                    " its coarsest level may have; use the block-Jacobi preconditioner");
       }
       aggregation_.reset();  // Automatic: face blocks
+    } else if (recording_ == AdmmRecording::SingleWorkgroup && aggregation_->levelCount() > 1) {
+      aggregation_.reset();  // Automatic: a cycle this recording cannot run; face blocks
     } else {
       multigrid_ = std::make_unique<Multigrid>(context_, algebra_, *aggregation_, K0_, K0_);
     }
@@ -421,8 +422,10 @@ std::uint32_t AdmmKernels::singleWorkgroupBudget(std::uint32_t k) const {
   const std::uint64_t reduction = 2 * columns * (parts + 2) + 2 * (group / parts + 2) + columns;
   const std::uint64_t rows = (n_ / block_ + group - 1) / group * block_;
   const std::uint64_t constraintRows = (m_ + group - 1) / group;
-  const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 2 * block_ + 2) + 2 * reduction;
-  const std::uint64_t pcg = rows * columns * (maxK + block_ + 4) + 2 * reduction + 4 * kSingleWorkgroupColumns;
+  // A row of the preconditioner: a block's, or of K's whole inverse, four entries per pass.
+  const std::uint64_t preconditionerRow = multigrid_ ? (n_ + 3) / 4 + 4 : block_;
+  const std::uint64_t start = rows * columns * (longestRow(Ct_) + maxK + 2 * preconditionerRow + 2) + 2 * reduction;
+  const std::uint64_t pcg = rows * columns * (maxK + preconditionerRow + 4) + 2 * reduction + 4 * kSingleWorkgroupColumns;
   const std::uint64_t update = constraintRows * columns * (longestRow(C_) + 2) + rows * columns;
   const std::uint64_t unit = std::max({start, pcg, update}) + 4;
   const std::uint64_t fixed = 8 * kSingleWorkgroupColumns;
@@ -433,7 +436,9 @@ bool AdmmKernels::useSingleWorkgroup(std::uint32_t k) const {
   const bool fits = k <= kSingleWorkgroupColumns &&
                     context_.info().maxStorageBuffersPerStage >= kSingleWorkgroupBuffers &&
                     singleWorkgroupBudget(k) > 0;
-  if (multigrid_) return false;  // the cycle is recorded only in the multi-dispatch PCG
+  // The cycle is recorded only in the multi-dispatch PCG; its coarsest level alone (K's
+  // whole inverse) the single-workgroup kernel applies itself.
+  if (multigrid_ && !multigrid_->wholeInverse()) return false;
   switch (recording_) {
     case AdmmRecording::MultiDispatch: return false;
     case AdmmRecording::Automatic: return fits && n_ <= kSingleWorkgroupUnknowns;
@@ -483,10 +488,12 @@ void AdmmKernels::prepare(std::uint32_t k) {
         context_, dot_, std::initializer_list<BufferRange>{w.r.data(), w.preconditioned.data(), w.pcg.partial()});
   }
   if (w.singleWorkgroup) {
+    // Face blocks' inverses, or K's whole inverse (the only multigrid this recording runs).
+    const Array<double>& preconditioner = multigrid_ ? *multigrid_->wholeInverse() : inverseBlocks_;
     w.singleWorkgroupSet = std::make_unique<DescriptorSet>(
         context_, singleWorkgroup_,
         std::initializer_list<BufferRange>{
-            devK_.rowOffsets(), devK_.columns(), devK_.values(), inverseBlocks_, devC_.rowOffsets(),
+            devK_.rowOffsets(), devK_.columns(), devK_.values(), preconditioner, devC_.rowOffsets(),
             devC_.columns(), devC_.values(), devCt_.rowOffsets(), devCt_.columns(), devCt_.values(), w.q.data(),
             w.x.data(), w.xTilde.data(), w.r.data(), w.preconditioned.data(), w.p.data(), w.Kp.data(),
             w.lower.data(), w.upper.data(), w.y.data(), w.yPrevious.data(), w.z.data(), rhoRows_, w.state});

@@ -155,8 +155,18 @@ void AdmmKernels::recordSingleWorkgroup(Sequence& s, int count, int dispatches, 
   const auto cap = static_cast<std::uint32_t>(withinSolverLimit(kMaxInnerIterations));
   const DescriptorSet& set = *w.singleWorkgroupSet;
   for (int d = 0; d < dispatches; ++d) {
-    const SingleWorkgroupPush push{n_,    m_,    w.k, static_cast<std::uint32_t>(count), cap, w.budget,
-                                   begin && d == 0 ? 1u : 0u, block_, settings_.sigma, relaxation_,
+    const SingleWorkgroupPush push{n_,
+                                   m_,
+                                   w.k,
+                                   static_cast<std::uint32_t>(count),
+                                   cap,
+                                   w.budget,
+                                   begin && d == 0 ? 1u : 0u,
+                                   block_,
+                                   multigrid_ ? 1u : 0u,
+                                   0u,
+                                   settings_.sigma,
+                                   relaxation_,
                                    tolerance * tolerance};
     s.dispatch(singleWorkgroup_, set, push, 1);
     s.barrier();

@@ -50,6 +50,8 @@ inline std::vector<std::uint32_t> packSides(const std::vector<compute::BoundSide
 }
 struct SingleWorkgroupPush {
   std::uint32_t n, m, k, iterations, cap, budget, begin, block;
+  std::uint32_t dense;  ///< 1: the preconditioner is K's whole inverse, not its blocks'
+  std::uint32_t unused;
   double sigma, alpha, tolerance2;
 };
 

@@ -169,6 +169,10 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
 
 Multigrid::~Multigrid() = default;
 
+const Array<double>* Multigrid::wholeInverse() const {
+  return levelCount() == 1 ? &levels_.front()->K->values() : nullptr;
+}
+
 void Multigrid::setK1(Sequence& sequence, const Array<double>& k1) {
   k1Set_ = true;
   const int L = levelCount();

@@ -82,6 +82,10 @@ class Multigrid {
   void record(Sequence& sequence, const Binding& binding, const Buffer* arguments, std::size_t triple);
 
   int levelCount() const { return static_cast<int>(levels_.size()); }
+  /// With one level, the cycle is K's dense inverse (row-major, rows x rows, formed by
+  /// setRho): the array that holds it, for kernels that apply it themselves. Null with
+  /// coarse levels.
+  const Array<double>* wholeInverse() const;
 
  private:
   struct Level;
