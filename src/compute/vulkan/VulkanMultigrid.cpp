@@ -22,11 +22,11 @@ struct CoarsestInvertPush {  // mg_coarsest_invert
 };
 
 /// Elimination steps per dispatch of an inversion of `rows` rows: CPU devices split it (a
-/// step costs each lane about rows^2 / lanes loop back-edges; kCpuLoopBackEdges); GPUs run
-/// it whole.
+/// step of the upper triangle's update costs each lane at most rows (rows + 1) / (2 lanes)
+/// + rows loop back-edges, plus its row and column; kCpuLoopBackEdges); GPUs run it whole.
 std::uint32_t inversionSteps(const Context& context, std::uint32_t rows, std::uint32_t lanes) {
   if (!isCpuDevice(context)) return std::max<std::uint32_t>(rows, 1);
-  const std::uint64_t perStep = (std::uint64_t{rows} * rows + 2 * rows) / lanes + 4;
+  const std::uint64_t perStep = std::uint64_t{rows} * (rows + 1) / (2 * lanes) + rows + 2 * rows / lanes + 4;
   return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(kCpuLoopBackEdges / perStep, 1, std::max<std::uint32_t>(rows, 1)));
 }
 
@@ -221,6 +221,9 @@ void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& fai
     sequence.dispatch(coarsestInvert_, {dense, failure}, CoarsestInvertPush{rows, begin, end, kCoarsestFailure}, 1);
     sequence.barrier();
   }
+  // The sweeps leave -K^-1 in the upper triangle: negated and mirrored.
+  sequence.dispatch(coarsestInvert_, {dense, failure}, CoarsestInvertPush{rows, rows, rows, kCoarsestFailure}, 1);
+  sequence.barrier();
 }
 
 std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks,
