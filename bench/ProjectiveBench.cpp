@@ -141,6 +141,10 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   plano::projective::GlobalStepSettings settings;
   settings.epsilonStart = plano::projective::EpsilonStart::ExactFirst;
   settings.qp.preconditioner = preconditioner;
+  // Every repetition solves the identical step: warm-started from the last one's solution
+  // (BoxQpSettings::warmStartEqualities, the global step's default) the device's exact
+  // step would start solved and take no ADMM iteration.
+  settings.qp.warmStartEqualities = false;
   InnerSolveSplit split;
   settings.qp.onCheck = [&split](const plano::compute::AdmmCheck& check) { split.observe(check); };
   plano::projective::GlobalStep global(*backend, space, fixed, settings);
