@@ -104,8 +104,9 @@ TEST_F(VulkanMultigrid, OneLevelIsTheExactInverse) {
 }
 
 TEST_F(VulkanMultigrid, ACoarsestLevelSplitAcrossDispatchesIsInvertedOnTheDeviceExactly) {
-  // 64 faces, all 64 blocks (256 rows) on one level: on a CPU device its elimination runs
-  // in several dispatches (each within llvmpipe's loop limit).
+  // 64 faces, all 64 blocks (256 rows) on one level: its elimination runs one dispatch per
+  // step, each step's rows dealt out among workgroups (one per core on a CPU device), and
+  // each step defers its pivot's row and column to the next.
   const auto [K0, K1] = splitK(globalStepMatrices(8));
   compute::BlockMultigridSettings settings{4};
   settings.coarsestBlocks = 64;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <thread>
 
 #include "compute/SparsePattern.h"
 #include "compute/vulkan/LinearAlgebraPushConstants.h"
@@ -18,16 +19,24 @@ struct CoarsestAssemblePush {  // mg_coarsest_assemble
   double rho;
 };
 struct CoarsestInvertPush {  // mg_coarsest_invert
-  std::uint32_t rows, begin, end, failureCode;
+  std::uint32_t rows, step, failureCode, unused;
 };
 
-/// Elimination steps per dispatch of an inversion of `rows` rows: CPU devices split it (a
-/// step of the upper triangle's update costs each lane at most rows (rows + 1) / (2 lanes)
-/// + rows loop back-edges, plus its row and column; kCpuLoopBackEdges); GPUs run it whole.
-std::uint32_t inversionSteps(const Context& context, std::uint32_t rows, std::uint32_t lanes) {
-  if (!isCpuDevice(context)) return std::max<std::uint32_t>(rows, 1);
-  const std::uint64_t perStep = std::uint64_t{rows} * (rows + 1) / (2 * lanes) + rows + 2 * rows / lanes + 4;
-  return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(kCpuLoopBackEdges / perStep, 1, std::max<std::uint32_t>(rows, 1)));
+/// Workgroups of one elimination step of the coarsest level's inversion (rows of the upper
+/// triangle dealt out among them; shaders/mg_coarsest_invert.comp). A CPU device (lavapipe)
+/// runs a workgroup on one of the host's cores, and each workgroup loads the pivot's whole
+/// column: one per core. A GPU gets about 16 entries per invocation. One step is within
+/// llvmpipe's loop limit (kCpuLoopBackEdges) even in one workgroup: its lanes loop about
+/// rows^2 / (2 lanes) + 2 rows times, 10 240 for kMaxCoarsestRows.
+std::uint32_t inversionGroups(const Context& context, std::uint32_t rows) {
+  std::uint64_t groups = 1;
+  if (isCpuDevice(context)) {
+    groups = std::max(1u, std::thread::hardware_concurrency());
+  } else {
+    const std::uint64_t entries = std::uint64_t{rows} * (rows + 1) / 2;
+    groups = (entries + 16 * singleWorkgroupLanes(context) - 1) / (16 * singleWorkgroupLanes(context));
+  }
+  return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(groups, 1, std::max<std::uint32_t>(rows, 1)));
 }
 
 /// A's pattern with every stored value 1 (no cancellation when coarsened).
@@ -106,8 +115,7 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       prolong_(context, "mg_prolong", 3, sizeof(TransferPush)),
       assemble_(context, "admm_assemble", 5, sizeof(AssemblePush)),
       coarsestAssemble_(context, "mg_coarsest_assemble", 5, sizeof(CoarsestAssemblePush)),
-      coarsestInvert_(context, "mg_coarsest_invert", 2, sizeof(CoarsestInvertPush), singleWorkgroupLanes(context)),
-      inversionStepsPerDispatch_(1),
+      coarsestInvert_(context, "mg_coarsest_invert", 3, sizeof(CoarsestInvertPush), singleWorkgroupLanes(context)),
       noRows_(context, 1, MemoryClass::Device, "multigrid unused rows") {
   const int L = aggregation_.levelCount();
   const std::vector<compute::SparseMatrix> patternLevels = aggregation_.coarsen(ones(pattern));
@@ -151,7 +159,8 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       full.makeCompressed();
       level->K = std::make_unique<DeviceCsrMatrix>(context, full);
       coarsestK0_ = std::make_unique<DeviceCsrMatrix>(context, onPattern(k0Levels[l], patternLevels[l]));
-      inversionStepsPerDispatch_ = inversionSteps(context, level->rows, singleWorkgroupLanes(context));
+      sweepSaved_ = std::make_unique<Array<double>>(context, 2 * (std::size_t{level->rows} + 1), MemoryClass::Device,
+                                                    "multigrid inversion's saved columns");
     }
     patterns_.push_back(patternLevels[l]);
     levels_.push_back(std::move(level));
@@ -216,14 +225,13 @@ void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& fai
                     {coarsestK0_->rowOffsets(), coarsestK0_->columns(), coarsestK0_->values(), *coarsestK1Values_, dense},
                     CoarsestAssemblePush{rows, 0, rho}, groupsFor(context_, rows));
   sequence.barrier();
-  for (std::uint32_t begin = 0; begin < rows; begin += inversionStepsPerDispatch_) {
-    const std::uint32_t end = std::min(rows, begin + inversionStepsPerDispatch_);
-    sequence.dispatch(coarsestInvert_, {dense, failure}, CoarsestInvertPush{rows, begin, end, kCoarsestFailure}, 1);
+  // One dispatch per elimination step, then one that negates and mirrors the sweeps' -K^-1.
+  const DescriptorSet& inversion = sequence.keep(coarsestInvert_, {dense, failure, *sweepSaved_});
+  const std::uint32_t groups = inversionGroups(context_, rows);
+  for (std::uint32_t step = 0; step <= rows; ++step) {
+    sequence.dispatch(coarsestInvert_, inversion, CoarsestInvertPush{rows, step, kCoarsestFailure, 0}, groups);
     sequence.barrier();
   }
-  // The sweeps leave -K^-1 in the upper triangle: negated and mirrored.
-  sequence.dispatch(coarsestInvert_, {dense, failure}, CoarsestInvertPush{rows, rows, rows, kCoarsestFailure}, 1);
-  sequence.barrier();
 }
 
 std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, const Array<double>& inverseBlocks,

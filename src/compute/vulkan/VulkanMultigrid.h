@@ -11,8 +11,8 @@
 // (admm_assemble) and the block-Jacobi inverses of every level but the coarsest
 // (block_jacobi_inverse), and the coarsest level's dense inverse (at most
 // kMaxCoarsestRows rows): assembled dense from its two small matrices (mg_coarsest_assemble)
-// and inverted in place by the sweep operator (symmetric Gauss-Jordan) in one workgroup
-// (mg_coarsest_invert). Before, the host inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
+// and inverted in place by the sweep operator (symmetric Gauss-Jordan), one dispatch per
+// elimination step over the workgroups a row fills (mg_coarsest_invert). Before, the host inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
 // deformation, up to 8 MiB), after downloading the coarsest K1 at each new C.
 //
 // One cycle: on each level, z = S r (block-Jacobi), then r_coarse = Z^T (r - K z) in one
@@ -103,7 +103,7 @@ class Multigrid {
   bool k1Set_ = false;
   Pipeline spmv_, scale_, residual_, scaleAdd_, restrictResidual_, prolong_, assemble_, coarsestAssemble_,
       coarsestInvert_;
-  std::uint32_t inversionStepsPerDispatch_;
+  std::unique_ptr<Array<double>> sweepSaved_;  ///< The inversion's two saved pivot columns.
   Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
 };
 

@@ -33,8 +33,13 @@ class Sequence {
   template <class Push>
   void dispatch(const Pipeline& pipeline, std::initializer_list<BufferRange> buffers, const Push& push,
                 std::uint32_t groupsX, std::uint32_t groupsY = 1) {
+    dispatch(pipeline, keep(pipeline, buffers), push, groupsX, groupsY);
+  }
+  /// A descriptor set of `buffers` for `pipeline` that the sequence keeps alive until the
+  /// next begin(): one set for many dispatches of a recording on the same buffers.
+  const DescriptorSet& keep(const Pipeline& pipeline, std::initializer_list<BufferRange> buffers) {
     sets_.push_back(std::make_unique<DescriptorSet>(context_, pipeline, buffers));
-    dispatch(pipeline, *sets_.back(), push, groupsX, groupsY);
+    return *sets_.back();
   }
   /// Record a dispatch whose workgroup counts (three uint32) are read from `arguments` at
   /// byte `offset` when it runs: a kernel recorded earlier can size it, or make it empty.
