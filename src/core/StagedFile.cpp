@@ -1,6 +1,7 @@
 #include "core/StagedFile.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,14 +13,23 @@
 
 namespace plano {
 
-StagedFile::StagedFile(std::filesystem::path target, std::string shown)
-    : target_(std::move(target)), shown_(std::move(shown)) {
+namespace {
+
+/// ".NAME.KINDPID-RANDOM" next to `target`.
+std::filesystem::path sibling(const std::filesystem::path& target, const char* kind) {
   std::random_device random;
   // Built by appending: GCC 12 warns falsely (-Wrestrict) on "." + string.
   std::string name = ".";
-  name += target_.filename().string();
-  name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(random());
-  const std::filesystem::path temporary = target_.parent_path() / name;
+  name += target.filename().string();
+  name += kind + std::to_string(::getpid()) + "-" + std::to_string(random());
+  return target.parent_path() / name;
+}
+
+}  // namespace
+
+StagedFile::StagedFile(std::filesystem::path target, std::string shown)
+    : target_(std::move(target)), shown_(std::move(shown)) {
+  const std::filesystem::path temporary = sibling(target_, ".tmp");
   fd_ = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd_ < 0) throwBadInput(shown_ + ": cannot write (" + std::strerror(errno) + ")");
   temporary_ = temporary;
@@ -27,10 +37,9 @@ StagedFile::StagedFile(std::filesystem::path target, std::string shown)
 
 StagedFile::~StagedFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!temporary_.empty()) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary_, ignored);
-  }
+  std::error_code ignored;
+  if (!temporary_.empty()) std::filesystem::remove(temporary_, ignored);
+  if (!previous_.empty()) std::filesystem::remove(previous_, ignored);
 }
 
 void StagedFile::write(const std::string& content, const std::function<void()>& between) {
@@ -60,6 +69,32 @@ void StagedFile::commit() {
   std::filesystem::rename(temporary_, target_, ec);
   if (ec) throwBadInput(shown_ + ": cannot replace the file: " + ec.message());
   temporary_.clear();
+  committed_ = true;
+}
+
+bool StagedFile::keepPrevious() {
+  struct stat info {};
+  if (::lstat(target_.c_str(), &info) != 0) {
+    kept_ = errno == ENOENT;  // nothing to keep: restoring removes the new file
+    return kept_;
+  }
+  const std::filesystem::path link = sibling(target_, ".old");
+  if (::link(target_.c_str(), link.c_str()) != 0) return false;
+  previous_ = link;
+  kept_ = true;
+  return true;
+}
+
+void StagedFile::restorePrevious() {
+  if (!committed_ || !kept_) return;
+  std::error_code ec;
+  if (previous_.empty()) {
+    std::filesystem::remove(target_, ec);
+  } else {
+    std::filesystem::rename(previous_, target_, ec);
+    if (!ec) previous_.clear();  // a link that could not go back is removed with this object
+  }
+  committed_ = false;
 }
 
 }  // namespace plano

@@ -16,7 +16,7 @@ class StagedFile {
   /// link does not redirect: the caller resolves links). `shown` names the file in
   /// messages. Throws Error(BadInput) when it cannot be created.
   StagedFile(std::filesystem::path target, std::string shown);
-  /// Removes the temporary file unless commit() renamed it.
+  /// Removes the temporary file unless commit() renamed it, and the kept old file.
   ~StagedFile();
   StagedFile(const StagedFile&) = delete;
   StagedFile& operator=(const StagedFile&) = delete;
@@ -28,11 +28,23 @@ class StagedFile {
   /// Rename the written file over the target. Throws Error(BadInput) when it cannot.
   void commit();
 
+  /// Before commit(): keep the target's current file under a second name (a hard link
+  /// ".NAME.oldPID-RANDOM"), so that restorePrevious() can put it back. False where it
+  /// cannot be kept (a file system without hard links); true where there is none to keep.
+  bool keepPrevious();
+  /// After commit(), undo it: the kept file renamed back over the target, or the target
+  /// removed where there was none before. Best effort, without throwing: it runs while
+  /// another failure is being reported.
+  void restorePrevious();
+
  private:
   std::filesystem::path target_;
   std::string shown_;
   std::filesystem::path temporary_;  ///< Empty once renamed.
   int fd_ = -1;                      ///< Open until write() closes it.
+  std::filesystem::path previous_;   ///< The kept link to the old file (keepPrevious), or empty.
+  bool kept_ = false;                ///< keepPrevious() succeeded.
+  bool committed_ = false;
 };
 
 }  // namespace plano

@@ -176,6 +176,34 @@ TEST_F(OutputGuard, FilesOfOneRunAreWrittenAllOrNone) {
   both.commit();
   EXPECT_EQ(slurp(dir_ / "first.obj"), "one\n");
   EXPECT_EQ(slurp(dir_ / "second.json"), "two\n");
+  EXPECT_TRUE(hiddenFiles(dir_.path()).empty()) << "no temporary file and no kept old file stays";
+}
+
+TEST_F(OutputGuard, ARenameThatFailsMidwayPutsBackTheFilesRenamedBeforeIt) {
+  // All three are staged; then, before the last rename, its target becomes a folder with a
+  // file in it, over which no file can be renamed. The first file's old content comes back,
+  // the second, which did not exist, goes again.
+  std::ofstream(dir_ / "first.obj") << "KEEP\n";
+  OutputFiles files;
+  files.add(path("first.obj"), "new\n");
+  files.add(path("second.json"), "new\n");
+  files.add(path("third.json"), "new\n");
+  files.setBeforeRename([&](std::size_t i) {
+    if (i != 2) return;
+    std::filesystem::create_directory(dir_ / "third.json");
+    std::ofstream(dir_ / "third.json" / "inside") << "x\n";
+  });
+  try {
+    files.commit();
+    ADD_FAILURE() << "the failed rename was not reported";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput);
+    EXPECT_NE(std::string(e.what()).find("third.json"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(slurp(dir_ / "first.obj"), "KEEP\n");
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "second.json"));
+  EXPECT_TRUE(std::filesystem::is_directory(dir_ / "third.json"));
+  EXPECT_TRUE(hiddenFiles(dir_.path()).empty());
 }
 
 TEST_F(OutputGuard, WritingThroughALinkKeepsTheLink) {

@@ -164,7 +164,17 @@ void OutputFiles::commit() {
       staged.back()->write(files_[i].content, between);
     }
     between();
-    for (const auto& file : staged) file->commit();
+    for (const auto& file : staged) file->keepPrevious();
+    std::size_t renamed = 0;
+    try {
+      for (; renamed < staged.size(); ++renamed) {
+        if (beforeRename_) beforeRename_(renamed);
+        staged[renamed]->commit();
+      }
+    } catch (...) {
+      for (std::size_t i = 0; i < renamed; ++i) staged[i]->restorePrevious();
+      throw;
+    }
   }
   // Streams last, with signals let in: opening a FIFO waits for its reader, and Ctrl-C must
   // still end a run that waits for one that never comes.

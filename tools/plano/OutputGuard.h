@@ -5,6 +5,7 @@
 // format) is refused before it starts, not after a long computation, and the files of one
 // run are written together: all of them or, when one fails, none.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,7 +54,10 @@ OutputTarget resolveOutput(const std::string& path);
 
 /// The files of one run, written together by commit(): each regular file to a temporary
 /// file next to its target, and only once every one is complete are they renamed over
-/// their targets, so that a failed write leaves all of them as they were. Streams
+/// their targets, so that a failed write leaves all of them as they were. Until the last
+/// rename each target's old file is kept under a hard link (".NAME.oldPID-RANDOM"): a
+/// rename that fails midway puts back the files renamed before it (or removes those that
+/// did not exist), except on a file system without hard links. Streams
 /// (OutputTarget::stream) cannot be written atomically and are written last, after the
 /// renames. Temporary files are named ".NAME.tmpPID-RANDOM".
 class OutputFiles {
@@ -67,8 +71,11 @@ class OutputFiles {
   bool empty() const { return files_.empty(); }
 
   /// Write every file added. Throws Error(BadInput) naming the file that could not be
-  /// written (every target then untouched, unless a rename or a stream failed midway).
+  /// written (every target then as it was, unless a stream failed midway).
   void commit();
+
+  /// Called with each staged file's index before its rename (tests make one fail there).
+  void setBeforeRename(std::function<void(std::size_t)> hook) { beforeRename_ = std::move(hook); }
 
  private:
   struct File {
@@ -77,6 +84,7 @@ class OutputFiles {
   };
   std::vector<File> files_;
   bool interruptible_;
+  std::function<void(std::size_t)> beforeRename_;
 };
 
 }  // namespace plano::cli
