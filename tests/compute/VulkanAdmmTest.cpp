@@ -1401,6 +1401,19 @@ TEST_F(VulkanAdmm, TheSingleWorkgroupKernelAppliesKsWholeInverseAsTheMultiDispat
     EXPECT_LT(relativeDifference(single.x, multiDispatch.x), 1e-8);
   }
 
+  // Rows that are no multiple of the kernel's four entries per loop pass (30 unknowns in
+  // blocks of 3): the same solve in either recording.
+  const BoxQp small = randomBoxQp(30, 24, 17);
+  compute::AdmmSettings smallSettings = tightSettings();
+  smallSettings.preconditioner = compute::AdmmPreconditioner::Automatic;
+  smallSettings.preconditionerBlock = 3;
+  ASSERT_EQ(vk::AdmmKernels(context(), small.P, small.C, smallSettings).multigridLevels(), 1);
+  const AdmmRun smallMulti = runAdmm(context(), small, smallSettings, kRecordings[0]);
+  const AdmmRun smallSingle = runAdmm(context(), small, smallSettings, kRecordings[1]);
+  ASSERT_EQ(smallMulti.info.status, compute::AdmmStatus::Solved);
+  EXPECT_EQ(smallSingle.info.iterations, smallMulti.info.iterations);
+  EXPECT_LT(relativeDifference(smallSingle.x, smallMulti.x), 1e-8);
+
   // The automatic recording runs it in one workgroup.
   vk::AdmmKernels automatic(context(), recorder.qp.P, recorder.qp.C, settings);
   const Index n = recorder.qp.P.rows(), m = recorder.qp.C.rows(), k = recorder.qp.q.cols();
