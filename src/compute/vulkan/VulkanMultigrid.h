@@ -12,7 +12,8 @@
 // (block_jacobi_inverse), and the coarsest level's dense inverse (at most
 // kMaxCoarsestRows rows): assembled dense from its two small matrices (mg_coarsest_assemble)
 // and inverted in place by the sweep operator (symmetric Gauss-Jordan), one dispatch per
-// elimination step over the workgroups a row fills (mg_coarsest_invert). Before, the host inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
+// elimination step over several workgroups (mg_coarsest_invert). Before, the host
+// inverted it and uploaded the inverse at each rho update (200 kB on a 256-face
 // deformation, up to 8 MiB), after downloading the coarsest K1 at each new C.
 //
 // One cycle: on each level, z = S r (block-Jacobi), then r_coarse = Z^T (r - K z) in one
