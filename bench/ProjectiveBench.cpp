@@ -331,6 +331,57 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
   state.counters["nonzeros"] = static_cast<double>(K.nonZeros());
 }
 
+/// One rho update of a K small enough to be preconditioned by its whole inverse (at most
+/// vk::AdmmKernels::kMaxWholeInverseBlocks faces): K = K0 + rho K1 assembled dense and
+/// inverted on the device (shaders/mg_coarsest_assemble.comp, mg_coarsest_invert.comp),
+/// twice per step of a small mesh's deformation (the ADMM's K and the polish's K_A).
+void BM_WholeInverse(benchmark::State& state) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, BackendChoice::Vulkan);
+  if (!backend) return;
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
+  const plano::projective::ShapeSpace space(mesh);
+  const plano::compute::SparseMatrix C = compatibilityMatrix(space, 1);
+  plano::compute::SparseMatrix K1 = C.transpose() * C;
+  plano::compute::SparseMatrix identity(K1.rows(), K1.cols());
+  identity.setIdentity();
+  plano::compute::SparseMatrix K0 = identity * (1.0 + plano::compute::AdmmSettings{}.sigma) + K1 * 0.0;
+  K0.makeCompressed();
+  K1 = K1 + K0 * 0.0;  // on K0's pattern
+  K1.makeCompressed();
+  plano::compute::BlockMultigridSettings settings{4};
+  settings.coarsestBlocks = static_cast<int>(K0.rows() / 4);  // one level: K itself, inverted whole
+  const plano::compute::BlockAggregation aggregation(plano::compute::SparseMatrix(K0 + K1), settings);
+  try {
+    plano::vk::Context& context = static_cast<plano::compute::VulkanBackend*>(backend)->context();
+    plano::vk::LinearAlgebra algebra(context);
+    plano::vk::Multigrid multigrid(context, algebra, aggregation, K0, K0);
+    multigrid.setK1(K1);
+    plano::vk::Array<std::uint32_t> failure(context, 1, plano::vk::MemoryClass::Host, "failure");
+    const std::uint32_t none = ~0u;
+    failure.upload({&none, 1});
+    plano::vk::Sequence update(context);
+    update.begin();
+    multigrid.setRho(update, 1e3, failure);
+    update.end();
+    update.run();  // JIT outside the timed loop
+    double deviceSeconds = 0.0;
+    for (auto _ : state) {
+      update.run();
+      deviceSeconds += update.lastDeviceSeconds();
+    }
+    std::uint32_t failed = 0;
+    failure.download({&failed, 1});
+    if (failed != none) state.SkipWithError("K was not positive definite");
+    state.counters["device_ms"] = benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
+  } catch (const plano::Error& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  plano::bench::setFaceCounters(state, mesh);
+  state.counters["levels"] = aggregation.levelCount();
+  state.counters["rows"] = static_cast<double>(K0.rows());
+}
+
 /// The same matrix as a ScaledConstraintMatrix (its pattern once, values per step).
 plano::projective::ScaledConstraintMatrix scaledCompatibilityMatrix(const plano::projective::ShapeSpace& space) {
   std::vector<plano::projective::ScaledConstraintMatrix::Term> terms;
@@ -441,6 +492,7 @@ BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::benc
 BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
 BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
 BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
+BENCHMARK(BM_WholeInverse)->Arg(16)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, filled, true)
