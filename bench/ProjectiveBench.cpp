@@ -312,14 +312,7 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
       cycle.begin();
       multigrid.record(cycle, *binding, nullptr, 0);
       cycle.end();
-      cycle.run();  // JIT outside the timed loop
-      memory.markLoopStart();
-      double deviceSeconds = 0.0;
-      for (auto _ : state) {
-        cycle.run();
-        deviceSeconds += cycle.lastDeviceSeconds();
-      }
-      state.counters["device_ms"] = benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
+      plano::bench::timeSequence(state, cycle, [&] { memory.markLoopStart(); });
     } catch (const plano::Error& e) {  // e.g. larger than lavapipe's 2 GiB heap
       state.SkipWithError(e.what());
       return;
@@ -363,16 +356,10 @@ void BM_WholeInverse(benchmark::State& state) {
     update.begin();
     multigrid.setRho(update, 1e3, failure);
     update.end();
-    update.run();  // JIT outside the timed loop
-    double deviceSeconds = 0.0;
-    for (auto _ : state) {
-      update.run();
-      deviceSeconds += update.lastDeviceSeconds();
-    }
+    plano::bench::timeSequence(state, update);
     std::uint32_t failed = 0;
     failure.download({&failed, 1});
     if (failed != none) state.SkipWithError("K was not positive definite");
-    state.counters["device_ms"] = benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
   } catch (const plano::Error& e) {
     state.SkipWithError(e.what());
     return;

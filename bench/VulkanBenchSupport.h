@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "compute/Backend.h"
+#include "compute/vulkan/VulkanSequence.h"
 #include "mesh/Generators.h"
 
 namespace plano::bench {
@@ -110,6 +112,21 @@ inline void setThroughput(benchmark::State& state, double items, const char* nam
 inline void setFaceCounters(benchmark::State& state, const PolygonMesh& mesh) {
   state.counters["faces"] = static_cast<double>(mesh.faceCount());
   setThroughput(state, static_cast<double>(mesh.faceCount()));
+}
+
+/// Time a recorded device sequence: one run before the timed loop (the driver's lazy work
+/// stays out of it), `beforeLoop` (e.g. MemoryCounters::markLoopStart), then one run per
+/// iteration, with the device's own time (timestamp queries) as the device_ms counter.
+inline void timeSequence(benchmark::State& state, vk::Sequence& sequence,
+                         const std::function<void()>& beforeLoop = {}) {
+  sequence.run();
+  if (beforeLoop) beforeLoop();
+  double deviceSeconds = 0.0;
+  for (auto _ : state) {
+    sequence.run();
+    deviceSeconds += sequence.lastDeviceSeconds();
+  }
+  state.counters["device_ms"] = benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
 }
 
 /// The standard sizes; the two large ones run once (lavapipe is a CPU JIT: slow).

@@ -35,14 +35,7 @@ void BM_Spmv(benchmark::State& state, BackendChoice choice) {
     sequence.begin();
     algebra.spmv(sequence, deviceA, x, y);
     sequence.end();
-    sequence.run();  // JIT outside the timed loop
-    double deviceSeconds = 0.0;
-    for (auto _ : state) {
-      sequence.run();
-      deviceSeconds += sequence.lastDeviceSeconds();
-    }
-    state.counters["device_ms"] =
-        benchmark::Counter(1e3 * deviceSeconds, benchmark::Counter::kAvgIterations);
+    plano::bench::timeSequence(state, sequence);
   }
   state.counters["rows"] = static_cast<double>(A.rows());
   state.counters["nonzeros"] = static_cast<double>(A.nonZeros());
