@@ -72,17 +72,16 @@ void StagedFile::commit() {
   committed_ = true;
 }
 
-bool StagedFile::keepPrevious() {
+void StagedFile::keepPrevious() {
   struct stat info {};
   if (::lstat(target_.c_str(), &info) != 0) {
     kept_ = errno == ENOENT;  // nothing to keep: restoring removes the new file
-    return kept_;
+    return;
   }
   const std::filesystem::path link = sibling(target_, ".old");
-  if (::link(target_.c_str(), link.c_str()) != 0) return false;
+  if (::link(target_.c_str(), link.c_str()) != 0) return;
   previous_ = link;
   kept_ = true;
-  return true;
 }
 
 void StagedFile::restorePrevious() {

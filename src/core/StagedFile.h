@@ -29,9 +29,9 @@ class StagedFile {
   void commit();
 
   /// Before commit(): keep the target's current file under a second name (a hard link
-  /// ".NAME.oldPID-RANDOM"), so that restorePrevious() can put it back. False where it
-  /// cannot be kept (a file system without hard links); true where there is none to keep.
-  bool keepPrevious();
+  /// ".NAME.oldPID-RANDOM"), so that restorePrevious() can put it back. On a file system
+  /// without hard links it is not kept, and restorePrevious() leaves the new file.
+  void keepPrevious();
   /// After commit(), undo it: the kept file renamed back over the target, or the target
   /// removed where there was none before. Best effort, without throwing: it runs while
   /// another failure is being reported.
