@@ -353,6 +353,18 @@ AdmmInfo AdmmSolver::solve(const Eigen::MatrixXd& q, const RelaxedBounds& bounds
 AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                              const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
                              WarmStart warm) {
+  return run(q, lower, upper, relaxed, x, y, warm, true);
+}
+
+AdmmInfo AdmmSolver::load(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                          const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
+                          WarmStart warm) {
+  return run(q, lower, upper, relaxed, x, y, warm, false);
+}
+
+AdmmInfo AdmmSolver::run(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                         const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
+                         WarmStart warm, bool iterations) {
   if (relaxed) {
     if (relaxed->centre.rows() != m_ || relaxed->centre.cols() != q.cols() ||
         relaxed->relaxed.size() != static_cast<std::size_t>(m_)) {
@@ -497,6 +509,8 @@ AdmmInfo AdmmSolver::iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower
   s = kernels_->measure();
   if (converged()) {
     info.status = AdmmStatus::Solved;
+  } else if (!iterations) {
+    info.status = AdmmStatus::MaxIterationsReached;
   } else {
     // K is formed (on the CPU: factored) only for a start that needs iterations: a warm
     // start that already meets the tolerances (targets compatible to rounding, e.g. the

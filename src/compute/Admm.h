@@ -394,6 +394,14 @@ class AdmmSolver {
   AdmmInfo iterate(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                    const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
                    WarmStart warm = WarmStart::Given);
+  /// iterate() without an iteration: the kernels start from the warm starts and measure
+  /// them, and K is not formed. Solved when the start meets the tolerances, else
+  /// MaxIterationsReached with 0 iterations. The kernels' refinements (refineActiveSet)
+  /// then start from it: an all-equality problem's polish needs no ADMM iterate before it (projective/
+  /// BoxQp.h); an iterate() after them starts from the same point again.
+  AdmmInfo load(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y,
+                WarmStart warm = WarmStart::Given);
   /// max |C x - centre| over all rows and columns of relaxed bounds (their centre; epsilon
   /// is not used), measured where the kernels keep the iterate: they are started at x (the
   /// next solve starts again), and a q, centre and flags that the next start shares are
@@ -451,6 +459,11 @@ class AdmmSolver {
   double rho() const { return rho_; }
 
  private:
+  /// iterate() and load(): `iterations` false stops after the start's measurement.
+  AdmmInfo run(const DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+               const RelaxedBounds* relaxed, const DeviceMatrix& x, const Eigen::MatrixXd& y, WarmStart warm,
+               bool iterations);
+
   std::unique_ptr<AdmmKernels> kernels_;
   Eigen::Index n_;
   Eigen::Index m_;

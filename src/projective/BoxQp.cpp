@@ -29,6 +29,15 @@ BoxQpStatus toBoxQpStatus(compute::AdmmStatus status) {
 /// target (or absolute, for targets below 1): rounding.
 constexpr double kRoundingGoal = 1e-15;
 
+/// An all-equality problem's polish with no ADMM before it (BoxQpSolver::
+/// solveEqualitiesInPlace) stands once its residual is this fraction of the largest target
+/// (absolute below 1): near rounding. The ADMM's tolerance is no bound there: the maps'
+/// error is the residual amplified along C's softest directions (measured on the exact
+/// steps of GlobalStepCase, lavapipe: about 600 times on 256 faces, 2 600 times on 1k),
+/// and a 1k-face step polished from zero multipliers to a residual of 1.3e-6 (within the
+/// ADMM's 1.4e-6) gave maps 3.5e-3 from the CPU's. Warm-started steps reach 3e-15 .. 7e-15.
+constexpr double kEqualityPolishResidual = 1e-12;
+
 double infNorm(const Eigen::MatrixXd& m) { return m.size() == 0 ? 0.0 : m.cwiseAbs().maxCoeff(); }
 
 compute::SparseMatrix identity(Eigen::Index n, double value) {
@@ -173,6 +182,8 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   const bool allEqualities = lower.size() > 0 && lower == upper;
   const bool held = std::exchange(equalityIterateHeld_, false);
   compute::WarmStart warm = compute::WarmStart::Given;
+  // The work of an equality solve on the device that fell back to the ADMM, counted in its info.
+  BoxQpInfo spent;
   if (allEqualities) {
     const bool direct = settings_.equalitySolve == EqualitySolve::Direct ||
                         (settings_.equalitySolve == EqualitySolve::Automatic && backend_.factorsSpdMatrices());
@@ -196,39 +207,60 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
       // stiffer (4.8 -> 2.5 s).
       admm_->setRho(settings_.rho);
     }
+    // With multipliers to start from (a loop's last solve's, or given), the polish's method
+    // of multipliers where the ADMM's kernels keep the iterate, with no ADMM iteration.
+    const bool multipliers = warm == compute::WarmStart::Kept || y.size() > 0;
+    if (!direct && settings_.equalitySolve == EqualitySolve::Automatic && settings_.polish && multipliers &&
+        !equalityPolishFellShort_) {
+      const compute::AdmmInfo loaded = start ? admm_->load(q, lower, upper, relaxed, *start, y, warm)
+                                             : admm_->load(q, lower, upper, relaxed, x, y, warm);
+      if (solveEqualitiesInPlace(loaded, lower, info)) {
+        return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
+      }
+      // The ADMM then starts from the same point, and solves this solver's later exact steps.
+      spent = info;
+      equalityPolishFellShort_ = true;
+    }
   }
   const compute::AdmmInfo admm = start ? admm_->iterate(q, lower, upper, relaxed, *start, y, warm)
                                        : admm_->iterate(q, lower, upper, relaxed, x, y, warm);
   BoxQpInfo info;
   info.status = toBoxQpStatus(admm.status);
-  info.iterations = admm.iterations;
-  info.factorizations = admm.factorizations;
-  info.linearIterations = admm.linearIterations;
+  info.iterations = admm.iterations + spent.iterations;
+  info.factorizations = admm.factorizations + spent.factorizations;
+  info.linearIterations = admm.linearIterations + spent.linearIterations;
+  info.polishRefinements = spent.polishRefinements;
   info.primalResidual = admm.primalResidual;
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
-  // The solution where the ADMM keeps its iterate (`kept`: left there when the ADMM's
-  // kernels can), else downloaded.
-  bool onDevice = false;
-  const auto fetchSolution = [&] {
-    if (kept && !settings_.returnDuals) {
-      if (auto solution = admm_->solution()) {
-        *kept = std::move(*solution);
-        onDevice = true;
-        return;
-      }
-    }
-    admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
-  };
   if (polishing && polishInPlace(lower, upper, info)) {
-    fetchSolution();
-  } else if (polishing) {
+    return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
+  }
+  if (polishing) {
     Eigen::MatrixXd z;  // the host's polish needs the whole iterate
     admm_->download(x, y, z);
     info.polished = polish(q.values(), lower, upper, z, x, y, info.polishRefinements);
-  } else {
-    fetchSolution();
+    return finishSolve(info, lower, upper, allEqualities, false, x, y, kept);
+  }
+  return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
+}
+
+BoxQpInfo BoxQpSolver::finishSolve(BoxQpInfo& info, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                                   bool allEqualities, bool fetch, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                                   compute::DeviceMatrix* kept) {
+  // The solution where the ADMM keeps its iterate (`kept`: left there when the ADMM's
+  // kernels can), else downloaded.
+  bool onDevice = false;
+  if (fetch) {
+    std::optional<compute::DeviceMatrix> solution;
+    if (kept && !settings_.returnDuals) solution = admm_->solution();
+    if (solution) {
+      *kept = std::move(*solution);
+      onDevice = true;
+    } else {
+      admm_->downloadSolution(x, settings_.returnDuals ? &y : nullptr);
+    }
   }
   // On the device the kernels measure it at the iterate they keep: the solution.
   info.maxBoundViolation = onDevice ? admm_->boundViolation() : boundViolation(hostC() * x, lower, upper);
@@ -236,6 +268,32 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   if (info.polished) info.primalResidual = info.maxBoundViolation;
   if (kept && !onDevice) *kept = compute::DeviceMatrix(std::move(x));
   return info;
+}
+
+bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const Eigen::MatrixXd& bounds,
+                                         BoxQpInfo& info) {
+  info = BoxQpInfo();
+  info.direct = true;
+  info.rho = loaded.rho;
+  info.primalResidual = loaded.primalResidual;
+  info.dualResidual = loaded.dualResidual;
+  // A start that solves the problem comes back as given, as from the ADMM's first check.
+  if (loaded.status == compute::AdmmStatus::Solved) {
+    info.status = BoxQpStatus::Solved;
+    return true;
+  }
+  if (!polishInPlace(bounds, bounds, info)) return false;  // the kernels cannot: untouched
+  info.factorizations = 1;  // K_A, as a direct solve's
+  // Not formed (not positive definite) or no better: discarded already.
+  if (!info.polished) return false;
+  const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
+  if (!(admm_->boundViolation() <= kEqualityPolishResidual * std::max(1.0, largestTarget))) {
+    admm_->discardRefinement();
+    info.polished = false;
+    return false;
+  }
+  info.status = BoxQpStatus::Solved;
+  return true;
 }
 
 bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info) {

@@ -19,7 +19,8 @@
 //
 // A problem whose rows are all equalities (l = u: the global step's ε = 0 attempts) needs
 // no ADMM at all: the polish's solve with every row active is its exact solution, so it is
-// solved that way directly where the backend factors K (BoxQpSettings::equalitySolve). The ADMM took 30-50
+// solved that way directly where the backend factors K (BoxQpSettings::equalitySolve), and
+// on the device from a loop's warm start. The ADMM took 30-50
 // iterations there, each a solve with a K whose stiff equality rows made it the global
 // step's dearest part, and ended in that same polish.
 #include <Eigen/Core>
@@ -50,6 +51,12 @@ enum class EqualitySolve {
   /// vs 8.0 s, 1k faces a solve did not converge within 10 000 iterations (the fallback
   /// then took 106 s against the ADMM's 28 s, whose multigrid-preconditioned solves at a
   /// milder rho scale).
+  /// Except from a start with multipliers (a loop's next exact step, WarmStart::Kept, or
+  /// given ones) where the ADMM's kernels keep the iterate (the device): there the polish's
+  /// method of multipliers runs alone, in place, and stands once its residual is near
+  /// rounding; else (once per solver) the ADMM solves the step from the same start. It
+  /// saves the ADMM's K and its inversion: lavapipe deformations of the 8x8 / 10x10 grids,
+  /// 36 iterations, 11.5 -> 8.1-8.5 s and 27.0 -> 18.4-19.0 s.
   Automatic,
 };
 
@@ -206,6 +213,19 @@ class BoxQpSolver {
   BoxQpInfo solve(const compute::DeviceMatrix& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
                   const compute::RelaxedBounds* relaxed, const compute::DeviceMatrix* start, Eigen::MatrixXd& x,
                   Eigen::MatrixXd& y, compute::DeviceMatrix* kept = nullptr);
+  /// The solution's fetch (`fetch`: from the ADMM's kernels, into `kept` where they keep it
+  /// and the caller asks so, else into x), its bound violation, and whether the kernels hold
+  /// an all-equality solution for the next warm start.
+  BoxQpInfo finishSolve(BoxQpInfo& info, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
+                        bool allEqualities, bool fetch, Eigen::MatrixXd& x, Eigen::MatrixXd& y,
+                        compute::DeviceMatrix* kept);
+  /// An all-equality problem where the ADMM's kernels keep the iterate (EqualitySolve::
+  /// Automatic on the device) from a start with multipliers: the polish's method of
+  /// multipliers from the start `loaded` (compute::AdmmSolver::load), with no ADMM
+  /// iteration. True, with info, when the start was optimal or the polished residual is near
+  /// rounding (kEqualityPolishResidual in the .cpp); else false, the loaded start again the
+  /// iterate, and info.linearIterations and polishRefinements the work spent.
+  bool solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const Eigen::MatrixXd& bounds, BoxQpInfo& info);
   /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
   /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
   /// by the kernels; only the sides found (a byte per four rows and columns), the active
@@ -252,6 +272,12 @@ class BoxQpSolver {
   /// inaccurately): its iterate, where the ADMM keeps it, starts the next such solve
   /// (BoxQpSettings::warmStartEqualities).
   bool equalityIterateHeld_ = false;
+  /// An all-equality polish with no ADMM before it (solveEqualitiesInPlace) fell short of
+  /// rounding once: this problem's soft modes need more refinements than the polish runs,
+  /// so its later exact steps go to the ADMM at once instead of paying for the polish twice
+  /// (256-face deformation steps on lavapipe: 2 020 -> 3 262 PCG iterations when each
+  /// tried it).
+  bool equalityPolishFellShort_ = false;
 };
 
 /// The solver of a sequence of QPs whose C keeps one sparsity pattern (a loop's global

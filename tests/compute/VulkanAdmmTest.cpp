@@ -1591,6 +1591,72 @@ BothBackends solveOnBothBackends(const GlobalStepCase& problem, compute::Backend
   return both;
 }
 
+/// Two exact global steps of GlobalStepCase(side) in a row on `backend`, the second with
+/// the odd faces' targets turned as well, so that it starts from the first one's
+/// multipliers (BoxQpSettings::warmStartEqualities) away from its own solution.
+struct SecondExactStep {
+  projective::GlobalStepInfo info;
+  projective::FaceMaps maps;
+};
+SecondExactStep solveSecondExactStep(const GlobalStepCase& problem, compute::Backend& backend) {
+  projective::GlobalStep step(backend, problem.space, problem.fixed, problem.settings);
+  SecondExactStep second;
+  step.solve(problem.targets, problem.at, second.maps);
+  std::vector<Eigen::Matrix4d> turned = problem.targets;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (std::size_t f = 1; f < turned.size(); f += 2) turned[f].topLeftCorner<3, 3>() = R;
+  second.info = step.solve(turned, problem.at, second.maps);
+  return second;
+}
+
+TEST_F(VulkanAdmm, AWarmStartedExactStepIsSolvedByTheDevicesPolishAloneWithTheCpusMaps) {
+  // EqualitySolve::Automatic: from the last step's multipliers the device runs the polish's
+  // method of multipliers with no ADMM iteration, as the CPU solves the step directly.
+  GlobalStepCase problem(8);
+  problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
+  compute::CpuBackend cpu;
+  const SecondExactStep host = solveSecondExactStep(problem, cpu);
+  const SecondExactStep device = solveSecondExactStep(problem, backend());
+  ASSERT_EQ(device.info.attempts.size(), 1u);
+  EXPECT_EQ(device.info.status, projective::GlobalStepStatus::Solved);
+  EXPECT_EQ(device.info.epsilon, 0.0);
+  EXPECT_TRUE(device.info.attempts[0].direct);
+  EXPECT_EQ(device.info.admmIterations, 0);
+  EXPECT_GE(device.info.polishRefinements, 1);
+  EXPECT_GT(device.info.linearIterations, 0);
+  EXPECT_TRUE(host.info.attempts[0].direct);
+  EXPECT_LT(device.info.constraintResidual, 1e-12);
+  double worst = 0.0;
+  for (std::size_t f = 0; f < host.maps.maps.size(); ++f) {
+    worst = std::max(worst, (device.maps.maps[f] - host.maps.maps[f]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-10);
+}
+
+TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFromTheSameStart) {
+  // One refinement leaves the polish's residual far above rounding: the device discards it
+  // and the ADMM solves the step from the warm start, then polishes as usual.
+  GlobalStepCase problem(8);
+  problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
+  problem.settings.qp.polishIterations = 1;
+  compute::CpuBackend cpu;
+  const SecondExactStep host = solveSecondExactStep(problem, cpu);
+  const SecondExactStep device = solveSecondExactStep(problem, backend());
+  ASSERT_EQ(device.info.attempts.size(), 1u);
+  EXPECT_EQ(device.info.status, projective::GlobalStepStatus::Solved);
+  EXPECT_EQ(device.info.epsilon, 0.0);
+  EXPECT_FALSE(device.info.attempts[0].direct);
+  EXPECT_GT(device.info.admmIterations, 0);
+  // The discarded refinement and the ADMM's polish, one each.
+  EXPECT_EQ(device.info.polishRefinements, 2);
+  double worst = 0.0;
+  for (std::size_t f = 0; f < host.maps.maps.size(); ++f) {
+    worst = std::max(worst, (device.maps.maps[f] - host.maps.maps[f]).cwiseAbs().maxCoeff());
+  }
+  // One refinement after the ADMM: the ADMM's tolerance, not rounding.
+  EXPECT_LT(worst, 1e-5);
+}
+
 TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
   GlobalStepCase problem(10);
   problem.settings.qp.linearSolver.relativeTolerance = 1e-12;  // the CPU solves exactly
@@ -1613,8 +1679,8 @@ TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
 
 TEST_F(VulkanAdmm, TheDevicesAdmmGivesTheMapsTheCpuSolvesDirectly) {
   // EqualitySolve::Automatic: the CPU (CHOLMOD) solves the ε = 0 step directly; the
-  // device, where the direct solve's PCG iterations grow fast with the mesh, takes the
-  // ADMM and polishes. One solution.
+  // device, where the direct solve's PCG iterations from zero multipliers grow fast with
+  // the mesh, takes the ADMM and polishes. One solution.
   GlobalStepCase problem(8);
   problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
   const BothBackends both = solveOnBothBackends(problem, backend());
