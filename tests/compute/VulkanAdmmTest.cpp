@@ -1591,22 +1591,23 @@ BothBackends solveOnBothBackends(const GlobalStepCase& problem, compute::Backend
   return both;
 }
 
-/// Two exact global steps of GlobalStepCase(side) in a row on `backend`, the second with
-/// the odd faces' targets turned as well, so that it starts from the first one's
+/// The second of two exact global steps of `problem` in a row, on the CPU and on the
+/// device: it turns the odd faces' targets as well, so that it starts from the first one's
 /// multipliers (BoxQpSettings::warmStartEqualities) away from its own solution.
-struct SecondExactStep {
-  projective::GlobalStepInfo info;
-  projective::FaceMaps maps;
-};
-SecondExactStep solveSecondExactStep(const GlobalStepCase& problem, compute::Backend& backend) {
-  projective::GlobalStep step(backend, problem.space, problem.fixed, problem.settings);
-  SecondExactStep second;
-  step.solve(problem.targets, problem.at, second.maps);
+BothBackends solveSecondExactStepOnBothBackends(const GlobalStepCase& problem, compute::Backend& device) {
   std::vector<Eigen::Matrix4d> turned = problem.targets;
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
   for (std::size_t f = 1; f < turned.size(); f += 2) turned[f].topLeftCorner<3, 3>() = R;
-  second.info = step.solve(turned, problem.at, second.maps);
-  return second;
+  const auto secondStep = [&](compute::Backend& backend, projective::FaceMaps& maps) {
+    projective::GlobalStep step(backend, problem.space, problem.fixed, problem.settings);
+    step.solve(problem.targets, problem.at, maps);
+    return step.solve(turned, problem.at, maps);
+  };
+  compute::CpuBackend cpu;
+  BothBackends both;
+  both.hostInfo = secondStep(cpu, both.hostMaps);
+  both.deviceInfo = secondStep(device, both.deviceMaps);
+  return both;
 }
 
 TEST_F(VulkanAdmm, AWarmStartedExactStepIsSolvedByTheDevicesPolishAloneWithTheCpusMaps) {
@@ -1614,23 +1615,18 @@ TEST_F(VulkanAdmm, AWarmStartedExactStepIsSolvedByTheDevicesPolishAloneWithTheCp
   // method of multipliers with no ADMM iteration, as the CPU solves the step directly.
   GlobalStepCase problem(8);
   problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
-  compute::CpuBackend cpu;
-  const SecondExactStep host = solveSecondExactStep(problem, cpu);
-  const SecondExactStep device = solveSecondExactStep(problem, backend());
-  ASSERT_EQ(device.info.attempts.size(), 1u);
-  EXPECT_EQ(device.info.status, projective::GlobalStepStatus::Solved);
-  EXPECT_EQ(device.info.epsilon, 0.0);
-  EXPECT_TRUE(device.info.attempts[0].direct);
-  EXPECT_EQ(device.info.admmIterations, 0);
-  EXPECT_GE(device.info.polishRefinements, 1);
-  EXPECT_GT(device.info.linearIterations, 0);
-  EXPECT_TRUE(host.info.attempts[0].direct);
-  EXPECT_LT(device.info.constraintResidual, 1e-12);
-  double worst = 0.0;
-  for (std::size_t f = 0; f < host.maps.maps.size(); ++f) {
-    worst = std::max(worst, (device.maps.maps[f] - host.maps.maps[f]).cwiseAbs().maxCoeff());
-  }
-  EXPECT_LT(worst, 1e-10);
+  const BothBackends both = solveSecondExactStepOnBothBackends(problem, backend());
+  const projective::GlobalStepInfo& device = both.deviceInfo;
+  ASSERT_EQ(device.attempts.size(), 1u);
+  EXPECT_EQ(device.status, projective::GlobalStepStatus::Solved);
+  EXPECT_EQ(device.epsilon, 0.0);
+  EXPECT_TRUE(device.attempts[0].direct);
+  EXPECT_EQ(device.admmIterations, 0);
+  EXPECT_GE(device.polishRefinements, 1);
+  EXPECT_GT(device.linearIterations, 0);
+  EXPECT_TRUE(both.hostInfo.attempts[0].direct);
+  EXPECT_LT(device.constraintResidual, 1e-12);
+  EXPECT_LT(both.mapDifference(), 1e-10);
 }
 
 TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFromTheSameStart) {
@@ -1639,22 +1635,17 @@ TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFr
   GlobalStepCase problem(8);
   problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
   problem.settings.qp.polishIterations = 1;
-  compute::CpuBackend cpu;
-  const SecondExactStep host = solveSecondExactStep(problem, cpu);
-  const SecondExactStep device = solveSecondExactStep(problem, backend());
-  ASSERT_EQ(device.info.attempts.size(), 1u);
-  EXPECT_EQ(device.info.status, projective::GlobalStepStatus::Solved);
-  EXPECT_EQ(device.info.epsilon, 0.0);
-  EXPECT_FALSE(device.info.attempts[0].direct);
-  EXPECT_GT(device.info.admmIterations, 0);
+  const BothBackends both = solveSecondExactStepOnBothBackends(problem, backend());
+  const projective::GlobalStepInfo& device = both.deviceInfo;
+  ASSERT_EQ(device.attempts.size(), 1u);
+  EXPECT_EQ(device.status, projective::GlobalStepStatus::Solved);
+  EXPECT_EQ(device.epsilon, 0.0);
+  EXPECT_FALSE(device.attempts[0].direct);
+  EXPECT_GT(device.admmIterations, 0);
   // The discarded refinement and the ADMM's polish, one each.
-  EXPECT_EQ(device.info.polishRefinements, 2);
-  double worst = 0.0;
-  for (std::size_t f = 0; f < host.maps.maps.size(); ++f) {
-    worst = std::max(worst, (device.maps.maps[f] - host.maps.maps[f]).cwiseAbs().maxCoeff());
-  }
+  EXPECT_EQ(device.polishRefinements, 2);
   // One refinement after the ADMM: the ADMM's tolerance, not rounding.
-  EXPECT_LT(worst, 1e-5);
+  EXPECT_LT(both.mapDifference(), 1e-5);
 }
 
 TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
