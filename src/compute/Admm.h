@@ -253,6 +253,11 @@ struct ActiveSetRefinement {
   /// left it, and the ADMM's other columns (one refinement per active set, merged); z stays
   /// the ADMM's.
   bool keepResult = false;
+  /// When > 0: give up once the residual, contracting from here on as it has on average
+  /// since the first refinement, would not reach this within maxRefinements (a polish
+  /// whose result the caller rejects above it: the refinements left would be spent for
+  /// nothing).
+  double reach = 0.0;
 };
 
 /// What refineActiveSet did.

@@ -234,7 +234,7 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
-  if (polishing && polishInPlace(lower, upper, info)) {
+  if (polishing && polishInPlace(lower, upper, info, settings_.polishIterations)) {
     return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
   }
   if (polishing) {
@@ -282,12 +282,15 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
     info.status = BoxQpStatus::Solved;
     return true;
   }
-  if (!polishInPlace(bounds, bounds, info)) return false;  // the kernels cannot: untouched
+  const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
+  const double accepted = kEqualityPolishResidual * std::max(1.0, largestTarget);
+  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted)) {
+    return false;  // the kernels cannot: untouched
+  }
   info.factorizations = 1;  // K_A, as a direct solve's
   // Not formed (not positive definite) or no better: discarded already.
   if (!info.polished) return false;
-  const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
-  if (!(admm_->boundViolation() <= kEqualityPolishResidual * std::max(1.0, largestTarget))) {
+  if (!(admm_->boundViolation() <= accepted)) {
     admm_->discardRefinement();
     info.polished = false;
     return false;
@@ -296,7 +299,8 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
   return true;
 }
 
-bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info) {
+bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
+                                int maxRefinements, double reach) {
   std::vector<compute::BoundSide> sides;
   if (!admm_->findActiveSides(sides)) return false;
   const Eigen::Index m = C_.rows();
@@ -325,9 +329,9 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
         if (side == compute::BoundSide::Upper) largestTarget = std::max(largestTarget, std::abs(upper(i, c)));
       }
     }
-    const compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho,
-                                               settings_.polishIterations,
-                                               kRoundingGoal * std::max(1.0, largestTarget), sides, true};
+    compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho, maxRefinements,
+                                         kRoundingGoal * std::max(1.0, largestTarget), sides, true};
+    request.reach = reach;
     compute::ActiveSetRefinementInfo refined;
     Eigen::MatrixXd unusedX, unusedY;
     if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) {

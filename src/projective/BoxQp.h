@@ -54,9 +54,11 @@ enum class EqualitySolve {
   /// Except from a start with multipliers (a loop's next exact step, WarmStart::Kept, or
   /// given ones) where the ADMM's kernels keep the iterate (the device): there the polish's
   /// method of multipliers runs alone, in place, and stands once its residual is near
-  /// rounding; else (once per solver) the ADMM solves the step from the same start. It
-  /// saves the ADMM's K and its inversion: lavapipe deformations of the 8x8 / 10x10 grids,
-  /// 36 iterations, 11.5 -> 8.1-8.5 s and 27.0 -> 18.4-19.0 s.
+  /// rounding (within BoxQpSettings::equalityPolishIterations refinements, given up as soon
+  /// as their contraction shows it would not get there); else (once per solver) the ADMM
+  /// solves the step from the same start. It saves the ADMM's K and its inversion: lavapipe
+  /// deformations of the 8x8 / 10x10 grids, 36 iterations, 11.5 -> 8.1-8.5 s and 27.0 ->
+  /// 18.4-19.0 s.
   Automatic,
 };
 
@@ -77,6 +79,14 @@ inline constexpr double kIterativePolishRho = 1e5;
 struct BoxQpSettings : compute::AdmmSettings {
   bool polish = true;
   int polishIterations = 30;         ///< Max method-of-multipliers refinements of the polish.
+  /// Max refinements of the polish that solves a warm exact step alone
+  /// (EqualitySolve::Automatic on the device). More than polishIterations: falling short
+  /// costs the ADMM and a second polish, and the polish's refinements after its first
+  /// few (momentum-accelerated, loosely solved) are the cheap ones. Measured on lavapipe,
+  /// a 16x16 grid's deformation (first row fixed, far corner moved): from the last step's
+  /// multipliers (residual 5e-4) the polish is at 4e-10 after 30 refinements and at rounding
+  /// (1e-14) after 60.
+  int equalityPolishIterations = 60;
   /// Penalty of the polish's equality system; 0 picks kFactoredPolishRho where the backend
   /// factors SPD matrices (Backend::factorsSpdMatrices), kIterativePolishRho where it iterates.
   double polishRho = 0.0;
@@ -232,7 +242,10 @@ class BoxQpSolver {
   /// flags of each set and a few norms cross, and the iterate stays for the final download.
   /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
   /// untouched: polish() then works from the downloaded iterate).
-  bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info);
+  /// At most maxRefinements per set; `reach` > 0 gives up a set's refinements that would
+  /// not reach it (compute::ActiveSetRefinement::reach).
+  bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
+                     int maxRefinements, double reach = 0.0);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
   /// The direct solve of an all-equality problem (EqualitySolve::Direct) from

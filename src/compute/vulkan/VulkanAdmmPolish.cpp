@@ -188,6 +188,11 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // accelerated refinements solve only to kPolishSolveTolerance of their warm start's
   // residual.
   constexpr double kSlowContraction = 0.5;
+  // A reach (ActiveSetRefinement::reach) is judged after this many refinements: by then
+  // the first momentum cycle has shown the contraction (the first two are plain ones that
+  // reduce the fast modes, and would promise too much).
+  constexpr int kReachJudgedAfter = 10;
+  double first = 0.0, best = std::numeric_limits<double>::infinity();
   int sinceRestart = 0;
   bool accelerate = false;
   for (int r = 0; r < request.maxRefinements; ++r) {
@@ -215,6 +220,14 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
       if (std::isnan(residual)) break;
     }
     if (!(residual > request.goal)) break;  // NaN too: the caller rejects it
+    if (r == 0) first = residual;
+    best = std::min(best, residual);
+    if (request.reach > 0.0 && r >= kReachJudgedAfter) {
+      // The mean contraction per refinement so far (from the best residual: the momentum's
+      // overshoots come back), over the refinements left.
+      const double rate = std::pow(best / first, 1.0 / r);
+      if (best * std::pow(rate, request.maxRefinements - 1 - r) > request.reach) break;
+    }
     if (residual >= previous) {
       if (plain) break;    // the rounding floor
       accelerate = false;  // restart: a plain refinement next, which decides again
