@@ -940,6 +940,7 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
   EXPECT_GT(slowResidual, kGoal) << "rho 300 reached the goal: no test of giving up";
   EXPECT_GE(givenUp, 11) << "judged before the first momentum cycle";
   EXPECT_LT(givenUp, slow);
+  EXPECT_GT(givenUpResidual, kGoal);
   const int fast = refine(1000.0, 0.0, fastResidual);
   const int fastWithReach = refine(1000.0, kGoal, fastWithReachResidual);
   EXPECT_LE(fastResidual, kGoal);

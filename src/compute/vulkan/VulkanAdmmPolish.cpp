@@ -188,10 +188,10 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // accelerated refinements solve only to kPolishSolveTolerance of their warm start's
   // residual.
   constexpr double kSlowContraction = 0.5;
-  // A reach (ActiveSetRefinement::reach) is judged after this many refinements: by then
-  // the first momentum cycle has shown the contraction (the first two are plain ones that
-  // reduce the fast modes, and would promise too much).
-  constexpr int kReachJudgedAfter = 10;
+  // A reach (ActiveSetRefinement::reach) is judged from the refinement with this index on
+  // (the 11th): by then the first momentum cycle has shown the contraction (the first two
+  // are plain ones that reduce the fast modes, and would promise too much).
+  constexpr int kReachJudgedFrom = 10;
   double first = 0.0, best = std::numeric_limits<double>::infinity();
   int sinceRestart = 0;
   bool accelerate = false;
@@ -222,7 +222,7 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     if (!(residual > request.goal)) break;  // NaN too: the caller rejects it
     if (r == 0) first = residual;
     best = std::min(best, residual);
-    if (request.reach > 0.0 && r >= kReachJudgedAfter) {
+    if (request.reach > 0.0 && r >= kReachJudgedFrom) {
       // The mean contraction per refinement so far (from the best residual: the momentum's
       // overshoots come back), over the refinements left.
       const double rate = std::pow(best / first, 1.0 / r);
