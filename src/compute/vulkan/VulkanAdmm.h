@@ -109,7 +109,8 @@ class AdmmKernels final : public compute::AdmmKernels {
   /// (6.7e-13 without the floor; 1.7e-12 with 4e-15, 91 922 iterations).
   static constexpr double kPolishRoundingFloor = 1e-14;
   /// The target of a polish solve with momentum, relative to its warm start's residual:
-  /// ||r|| <= this times ||r0|| (plain refinements keep the inner solves' 1e-10). A
+  /// ||r|| <= this times ||r0|| (plain refinements keep the inner solves' 1e-10, but for
+  /// the restart after an accelerated one overshot: refineActiveSet). A
   /// refinement of the method of multipliers needs its step only to a fraction of the
   /// step's own size (an inexact augmented Lagrangian method), the more so where each
   /// refinement gains little: the accelerated ones run where the residual contracts by 0.5

@@ -195,18 +195,25 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   double first = 0.0, best = std::numeric_limits<double>::infinity();
   int sinceRestart = 0;
   bool accelerate = false;
+  // The restart after an accelerated refinement that overshot is a plain refinement solved
+  // loosely: the contraction is known to be slow there, and a tight solve (~100 PCG
+  // iterations against ~20) would cost as much as a whole momentum cycle's others. Only a
+  // tightly solved plain refinement decides the rounding floor: a loose one that does not
+  // reduce the residual is followed by one.
+  bool looseRestart = false;
   for (int r = 0; r < request.maxRefinements; ++r) {
     throwIfCancelled("the polish");
     if (!accelerate) sinceRestart = 0;
     const bool plain = sinceRestart == 0;
+    const bool tight = plain && !looseRestart;
     recordedMomentum(sinceRestart++).run();
     const double solveStart = state[kInnerIterations];
     double capped = state[kCappedSolves];
-    (plain ? p.solve : p.looseSolve).run();
+    (tight ? p.solve : p.looseSolve).run();
     w.state.download(state);
     while (state[kCappedSolves] > capped && state[kInnerIterations] - solveStart < maxIterations) {
       capped = state[kCappedSolves];
-      (plain ? p.resume : p.looseResume).run();  // continues the PCG where the capped run stopped
+      (tight ? p.resume : p.looseResume).run();  // continues the PCG where the capped run stopped
       w.state.download(state);
     }
     if (state[kCappedSolves] > capped) info.solvesConverged = false;
@@ -229,10 +236,12 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
       if (best * std::pow(rate, request.maxRefinements - 1 - r) > request.reach) break;
     }
     if (residual >= previous) {
-      if (plain) break;    // the rounding floor
-      accelerate = false;  // restart: a plain refinement next, which decides again
+      if (tight) break;       // the rounding floor
+      accelerate = false;     // restart: a plain refinement next, which decides again
+      looseRestart = !plain;  // loosely after an overshoot, tightly after a loose restart
     } else if (plain) {
       accelerate = residual > kSlowContraction * previous;
+      looseRestart = false;
     }
     previous = residual;
   }
