@@ -1325,7 +1325,8 @@ TEST_F(VulkanAdmm, ASlowlyContractingPolishIsAcceleratedTowardsTheRoundingFloor)
   // refinements and 1 010 PCG iterations (5.4e-14), against 27 and 1 294 (7.6e-14) with
   // plain refinements alone, every solve to 1e-10 of its warm start's residual. With the
   // accelerated refinements' solves to kPolishSolveTolerance: 18 refinements and 593 PCG
-  // iterations, x as close to the KKT solution (3.3e-11). (From the ADMM iterated with
+  // iterations, x as close to the KKT solution (3.3e-11); 552 since the restart after an
+  // overshoot is solved loosely as well. (From the ADMM iterated with
   // OSQP's over-relaxation, as these figures were; with the all-equality attempts' own,
   // AdmmSettings::equalityRelaxation, the ADMM stops at 3.1e-7 and the polish takes 29
   // refinements.)
