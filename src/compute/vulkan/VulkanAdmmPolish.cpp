@@ -179,8 +179,8 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // ~256-face exact step's polish runs into its 30-refinement cap, its residual falling by
   // ~0.7 per refinement. Where two plain refinements show such a slow contraction (above
   // kSlowContraction), Nesterov's momentum accelerates the next ones, restarted (a plain
-  // refinement that decides again) when the residual grows; a plain refinement that does
-  // not reduce it ends them (the rounding floor), as before. Fast contractions keep the
+  // refinement that decides again) when the residual grows; a tightly solved plain
+  // refinement that does not reduce it ends them (the rounding floor). Fast contractions keep the
   // plain method, whose next refinement starts at the solution within rounding. Measured
   // on that step (lavapipe, 30 refinements): residual 8.0e-12 -> 3.3e-14, polish PCG
   // iterations 2 599 -> 2 268 (BM_GlobalStep/vulkan/256; the bound in
