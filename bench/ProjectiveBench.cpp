@@ -5,6 +5,8 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/IterativeLinearSolvers>
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -261,23 +263,35 @@ plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeS
 /// 0.1 x 1e3 the ADMM's equality rows start at and the few 1e3 they reach): the host reference, one column after the other, or
 /// the device's recorded cycle (vk::Multigrid) with K's levels and block inverses in place.
 /// The device cycle's cost is its dispatches (lavapipe) or its memory traffic (a GPU).
+/// The exact step's K = K0 + rho K1 of a grid, K0 = (1 + sigma) I and K1 = C^T C on one
+/// pattern, at rho = 1e3.
+struct ExactStepMatrices {
+  static constexpr double rho = 1e3;
+  plano::compute::SparseMatrix K0, K1, K;
+  explicit ExactStepMatrices(const plano::projective::ShapeSpace& space) {
+    const plano::compute::SparseMatrix C = compatibilityMatrix(space, 1);
+    const double sigma = plano::compute::AdmmSettings{}.sigma;
+    K1 = C.transpose() * C;
+    plano::compute::SparseMatrix identity(K1.rows(), K1.cols());
+    identity.setIdentity();
+    K0 = identity * (1.0 + sigma) + K1 * 0.0;
+    K0.makeCompressed();
+    K1 = K1 + K0 * 0.0;  // on K0's pattern
+    K1.makeCompressed();
+    K = K0 + K1 * rho;
+    K.makeCompressed();
+  }
+};
+
 void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
   const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
   const plano::projective::ShapeSpace space(mesh);
-  const plano::compute::SparseMatrix C = compatibilityMatrix(space, 1);
-  const double sigma = plano::compute::AdmmSettings{}.sigma, rho = 1e3;
-  plano::compute::SparseMatrix K1 = C.transpose() * C;
-  plano::compute::SparseMatrix identity(K1.rows(), K1.cols());
-  identity.setIdentity();
-  plano::compute::SparseMatrix K0 = identity * (1.0 + sigma) + K1 * 0.0;
-  K0.makeCompressed();
-  K1 = K1 + K0 * 0.0;  // on K0's pattern
-  K1.makeCompressed();
-  plano::compute::SparseMatrix K = K0 + K1 * rho;
-  K.makeCompressed();
+  const ExactStepMatrices matrices(space);
+  const plano::compute::SparseMatrix &K0 = matrices.K0, &K1 = matrices.K1, &K = matrices.K;
+  const double rho = ExactStepMatrices::rho;
   const plano::compute::BlockAggregation aggregation(K, {4});
   const Eigen::MatrixXd r = plano::bench::jittered(Eigen::MatrixXd::Zero(K.rows(), 3), 1.0);
   if (choice == BackendChoice::Cpu) {
@@ -322,6 +336,52 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
   state.counters["levels"] = aggregation.levelCount();
   state.counters["rows"] = static_cast<double>(K.rows());
   state.counters["nonzeros"] = static_cast<double>(K.nonZeros());
+}
+
+/// Eigen's ConjugateGradient preconditioner that applies one V-cycle (set after compute()).
+class VCyclePreconditioner {
+ public:
+  template <typename Matrix>
+  VCyclePreconditioner& analyzePattern(const Matrix&) { return *this; }
+  template <typename Matrix>
+  VCyclePreconditioner& factorize(const Matrix&) { return *this; }
+  template <typename Matrix>
+  VCyclePreconditioner& compute(const Matrix&) { return *this; }
+  template <typename Rhs>
+  Eigen::VectorXd solve(const Rhs& r) const { return cycle->apply(r); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+  const plano::compute::BlockMultigrid* cycle = nullptr;
+};
+
+/// The host PCG solve of the exact step's K (rho 1e3) to 1e-10 from zero, preconditioned
+/// by the plain or the smoothed-aggregation V-cycle (BlockMultigridSettings::smoothProlongation):
+/// whether the smoothed cycle's fewer iterations pay for its denser levels. Counters: PCG
+/// iterations, the cycle's operator complexity, its setup in ms (outside the timed loop).
+void BM_MultigridPcg(benchmark::State& state, bool smoothProlongation) {
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
+  const plano::projective::ShapeSpace space(mesh);
+  const ExactStepMatrices matrices(space);
+  const Eigen::SparseMatrix<double> K(matrices.K);
+  plano::compute::BlockMultigridSettings settings;
+  settings.smoothProlongation = smoothProlongation;
+  const auto setupStart = std::chrono::steady_clock::now();
+  const plano::compute::BlockMultigrid cycle(matrices.K, settings);
+  const std::chrono::duration<double, std::milli> setup = std::chrono::steady_clock::now() - setupStart;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, VCyclePreconditioner> pcg;
+  pcg.setTolerance(1e-10);
+  pcg.compute(K);
+  pcg.preconditioner().cycle = &cycle;
+  std::mt19937 random(1);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(K.rows(), [&] { return uniform(random); });
+  for (auto _ : state) benchmark::DoNotOptimize(pcg.solve(b).eval().data());
+  if (pcg.info() != Eigen::Success) state.SkipWithError("PCG did not converge");
+  double entries = 0.0;
+  for (int l = 0; l < cycle.levelCount(); ++l) entries += static_cast<double>(cycle.nonZeros(l));
+  plano::bench::setFaceCounters(state, mesh);
+  state.counters["pcg_iterations"] = static_cast<double>(pcg.iterations());
+  state.counters["operator_complexity"] = entries / static_cast<double>(cycle.nonZeros(0));
+  state.counters["setup_ms"] = setup.count();
 }
 
 /// One rho update of a K small enough to be preconditioned by its whole inverse (at most
@@ -479,6 +539,8 @@ BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::benc
 BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
 BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
 BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_MultigridPcg, plain, false)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridPcg, smoothed, true)->Apply(plano::bench::standardSizes);
 BENCHMARK(BM_WholeInverse)->Arg(16)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStepConstraints, assembled, false)
     ->Arg(4096)->Arg(65536)->Arg(1 << 20)->Unit(benchmark::kMillisecond);

@@ -52,6 +52,53 @@ SparseMatrix prolongationOf(const std::vector<Index>& aggregate, Index coarseBlo
   return Z;
 }
 
+/// Level l's diagonal blocks inverted; throws Error(Numerical) for one that is not positive
+/// definite.
+std::vector<Eigen::MatrixXd> inverseDiagonalBlocks(const SparseMatrix& K, int b, int level) {
+  std::vector<Eigen::MatrixXd> inverses(static_cast<std::size_t>(K.rows() / b));
+  for (std::size_t i = 0; i < inverses.size(); ++i) {
+    const Eigen::MatrixXd D = diagonalBlock(K, static_cast<Index>(i), b);
+    const Eigen::LLT<Eigen::MatrixXd> llt(D);
+    if (llt.info() != Eigen::Success || !D.allFinite()) {
+      throwNumerical("multigrid: diagonal block " + std::to_string(i) + " of level " + std::to_string(level) +
+                     " is not positive definite");
+    }
+    inverses[i] = llt.solve(Eigen::MatrixXd::Identity(b, b));
+  }
+  return inverses;
+}
+
+/// D^-1 K for K's diagonal blocks' inverses (K's pattern: every diagonal block is stored).
+SparseMatrix blockJacobiScaled(const SparseMatrix& K, const std::vector<Eigen::MatrixXd>& inverses, int b) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(inverses.size() * static_cast<std::size_t>(b * b));
+  for (std::size_t i = 0; i < inverses.size(); ++i) {
+    const auto first = static_cast<Index>(i) * b;
+    for (int r = 0; r < b; ++r) {
+      for (int c = 0; c < b; ++c) entries.emplace_back(first + r, first + c, inverses[i](r, c));
+    }
+  }
+  SparseMatrix Dinverse(K.rows(), K.cols());
+  Dinverse.setFromTriplets(entries.begin(), entries.end());
+  return SparseMatrix(Dinverse * K);
+}
+
+/// lambda_max(D^-1 K), which is real and positive (D^-1 K is similar to D^-1/2 K D^-1/2), by
+/// power iteration from a fixed start: an estimate from below, enough for omega.
+double largestEigenvalue(const SparseMatrix& DinverseK) {
+  Eigen::VectorXd v(DinverseK.rows());
+  for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = 1.0 + static_cast<double>(i % 7) / 7.0;
+  v.normalize();
+  double lambda = 0.0;
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    Eigen::VectorXd w = DinverseK * v;
+    lambda = w.norm();
+    if (!(lambda > 0.0) || !std::isfinite(lambda)) throwNumerical("multigrid: D^-1 K has no positive spectrum");
+    v = w / lambda;
+  }
+  return lambda;
+}
+
 }  // namespace
 
 std::vector<Index> pairBlocks(const SparseMatrix& K, int block, Index& pairCount) {
@@ -133,7 +180,33 @@ std::vector<SparseMatrix> BlockAggregation::coarsen(const SparseMatrix& A) const
 
 BlockMultigrid::BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings) {
   const BlockAggregation aggregation(K, settings);
-  build(aggregation, aggregation.coarsen(K), settings.smootherDamping);
+  if (settings.smoothProlongation) {
+    buildSmoothed(aggregation, K, settings.smootherDamping);
+  } else {
+    build(aggregation, aggregation.coarsen(K), settings.smootherDamping);
+  }
+}
+
+void BlockMultigrid::buildSmoothed(const BlockAggregation& aggregation, const SparseMatrix& K,
+                                   double smootherDamping) {
+  const int b = aggregation.block();
+  std::vector<SparseMatrix> levels{K};
+  levels.front().makeCompressed();
+  std::vector<SparseMatrix> prolongations;
+  for (int l = 0; l + 1 < aggregation.levelCount(); ++l) {
+    const SparseMatrix& A = levels.back();
+    const SparseMatrix DinverseA = blockJacobiScaled(A, inverseDiagonalBlocks(A, b, l), b);
+    const double omega = 4.0 / (3.0 * largestEigenvalue(DinverseA));
+    const SparseMatrix Z = aggregation.prolongation(l);
+    SparseMatrix P = Z - SparseMatrix(DinverseA * Z) * omega;
+    P.prune(0.0);
+    SparseMatrix coarse = SparseMatrix(P.transpose()) * SparseMatrix(A * P);
+    coarse.makeCompressed();
+    prolongations.push_back(std::move(P));
+    levels.push_back(std::move(coarse));
+  }
+  build(aggregation, std::move(levels), smootherDamping);
+  for (std::size_t l = 0; l < prolongations.size(); ++l) levels_[l].prolongation = std::move(prolongations[l]);
 }
 
 BlockMultigrid::BlockMultigrid(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels,
@@ -151,19 +224,11 @@ void BlockMultigrid::build(const BlockAggregation& aggregation, std::vector<Spar
   }
   for (int l = 0; l < aggregation.levelCount(); ++l) {
     if (levels[l].rows() != aggregation.blocks(l) * b) throwUsage("multigrid: a level matrix of the wrong size");
-    Level level{std::move(levels[l]), {}, {}};
+    Level level{std::move(levels[l]), {}, {}, {}};
     if (l + 1 < aggregation.levelCount()) {
       level.aggregate = aggregation.aggregates(l);
-      level.inverseBlocks.resize(aggregation.blocks(l));
-      for (Index i = 0; i < aggregation.blocks(l); ++i) {
-        const Eigen::MatrixXd D = diagonalBlock(level.K, i, b);
-        const Eigen::LLT<Eigen::MatrixXd> llt(D);
-        if (llt.info() != Eigen::Success || !D.allFinite()) {
-          throwNumerical("multigrid: diagonal block " + std::to_string(i) + " of level " + std::to_string(l) +
-                         " is not positive definite");
-        }
-        level.inverseBlocks[i] = smootherDamping * llt.solve(Eigen::MatrixXd::Identity(b, b));
-      }
+      level.inverseBlocks = inverseDiagonalBlocks(level.K, b, l);
+      for (Eigen::MatrixXd& inverse : level.inverseBlocks) inverse *= smootherDamping;
     }
     levels_.push_back(std::move(level));
   }
@@ -190,6 +255,7 @@ Eigen::VectorXd BlockMultigrid::smooth(const Level& level, const Eigen::VectorXd
 }
 
 Eigen::VectorXd BlockMultigrid::restrictToCoarse(const Level& level, Index coarseRows, const Eigen::VectorXd& r) const {
+  if (level.prolongation.size() > 0) return level.prolongation.transpose() * r;
   const int b = block_;
   Eigen::VectorXd coarse = Eigen::VectorXd::Zero(coarseRows);
   for (std::size_t i = 0; i < level.aggregate.size(); ++i) {
@@ -201,16 +267,23 @@ Eigen::VectorXd BlockMultigrid::restrictToCoarse(const Level& level, Index coars
 Eigen::VectorXd BlockMultigrid::cycle(int l, const Eigen::VectorXd& r) const {
   if (l + 1 == levelCount()) return coarsest_.solve(r);
   const Level& level = levels_[l];
-  const int b = block_;
   Eigen::VectorXd z = smooth(level, r);
   Eigen::VectorXd residual = r - level.K * z;
-  const Eigen::VectorXd correction = cycle(l + 1, restrictToCoarse(level, rows(l + 1), residual));
-  for (std::size_t i = 0; i < level.aggregate.size(); ++i) {
-    z.segment(static_cast<Eigen::Index>(i) * b, b) += correction.segment(level.aggregate[i] * b, b);
-  }
+  addProlongated(level, cycle(l + 1, restrictToCoarse(level, rows(l + 1), residual)), z);
   residual = r - level.K * z;
   z += smooth(level, residual);
   return z;
+}
+
+void BlockMultigrid::addProlongated(const Level& level, const Eigen::VectorXd& coarse, Eigen::VectorXd& z) const {
+  if (level.prolongation.size() > 0) {
+    z += level.prolongation * coarse;
+    return;
+  }
+  const int b = block_;
+  for (std::size_t i = 0; i < level.aggregate.size(); ++i) {
+    z.segment(static_cast<Eigen::Index>(i) * b, b) += coarse.segment(level.aggregate[i] * b, b);
+  }
 }
 
 }  // namespace plano::compute
