@@ -258,6 +258,13 @@ struct ActiveSetRefinement {
   /// whose result the caller rejects above it: the refinements left would be spent for
   /// nothing).
   double reach = 0.0;
+  /// The refinements start far from the active-set solution (a loop's exact step polished
+  /// from the last step's multipliers), where the method of multipliers contracts slowly
+  /// from the first refinement on: the kernels that solve iteratively then solve the plain
+  /// refinements loosely too, as those with momentum, until one fails to reduce the
+  /// residual (the next, tight, decides the rounding floor). Near the solution (the ADMM's
+  /// polish) a tight solve lets a fast contraction reach rounding in a few refinements.
+  bool farStart = false;
 };
 
 /// What refineActiveSet did.

@@ -284,7 +284,7 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
   }
   const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
   const double accepted = kEqualityPolishResidual * std::max(1.0, largestTarget);
-  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted)) {
+  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted, true)) {
     return false;  // the kernels cannot: untouched
   }
   info.factorizations = 1;  // K_A, as a direct solve's
@@ -300,7 +300,7 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
 }
 
 bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                                int maxRefinements, double reach) {
+                                int maxRefinements, double reach, bool farStart) {
   std::vector<compute::BoundSide> sides;
   if (!admm_->findActiveSides(sides)) return false;
   const Eigen::Index m = C_.rows();
@@ -332,6 +332,7 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
     compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho, maxRefinements,
                                          kRoundingGoal * std::max(1.0, largestTarget), sides, true};
     request.reach = reach;
+    request.farStart = farStart;
     compute::ActiveSetRefinementInfo refined;
     Eigen::MatrixXd unusedX, unusedY;
     if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) {

@@ -81,8 +81,8 @@ struct BoxQpSettings : compute::AdmmSettings {
   int polishIterations = 30;         ///< Max method-of-multipliers refinements of the polish.
   /// Max refinements of the polish that solves a warm exact step alone
   /// (EqualitySolve::Automatic on the device). More than polishIterations: falling short
-  /// costs the ADMM and a second polish, and the polish's refinements after its first
-  /// few (momentum-accelerated, loosely solved) are the cheap ones. Measured on lavapipe,
+  /// costs the ADMM and a second polish, and the polish's refinements are cheap ones there
+  /// (loosely solved: compute::ActiveSetRefinement::farStart). Measured on lavapipe,
   /// a 16x16 grid's deformation (first row fixed, far corner moved): from the last step's
   /// multipliers (residual 5e-4) the polish is at 4e-10 after 30 refinements and at rounding
   /// (1e-14) after 60.
@@ -243,9 +243,10 @@ class BoxQpSolver {
   /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
   /// untouched: polish() then works from the downloaded iterate).
   /// At most maxRefinements per set; `reach` > 0 gives up a set's refinements that would
-  /// not reach it (compute::ActiveSetRefinement::reach).
+  /// not reach it (compute::ActiveSetRefinement::reach); `farStart` says the iterate is far
+  /// from the solution (compute::ActiveSetRefinement::farStart).
   bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                     int maxRefinements, double reach = 0.0);
+                     int maxRefinements, double reach = 0.0, bool farStart = false);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
   /// The direct solve of an all-equality problem (EqualitySolve::Direct) from
