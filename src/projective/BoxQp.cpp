@@ -37,6 +37,11 @@ constexpr double kRoundingGoal = 1e-15;
 /// and a 1k-face step polished from zero multipliers to a residual of 1.3e-6 (within the
 /// ADMM's 1.4e-6) gave maps 3.5e-3 from the CPU's. Warm-started steps reach 3e-15 .. 7e-15.
 constexpr double kEqualityPolishResidual = 1e-12;
+/// Where that polish stops, as a fraction of the residual it is accepted at: near rounding
+/// (warm steps reach 3e-15 .. 7e-15), whose last digits its loose solves could chase for
+/// many refinements (with a cap of 200, a 16x16 grid's 8-iteration deformation took 11 616
+/// PCG iterations going for kRoundingGoal, 10 263 with a cap of 60).
+constexpr double kEqualityPolishGoal = 1e-2;
 
 double infNorm(const Eigen::MatrixXd& m) { return m.size() == 0 ? 0.0 : m.cwiseAbs().maxCoeff(); }
 
@@ -284,7 +289,8 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
   }
   const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
   const double accepted = kEqualityPolishResidual * std::max(1.0, largestTarget);
-  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted, true)) {
+  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted, true,
+                     kEqualityPolishGoal * accepted)) {
     return false;  // the kernels cannot: untouched
   }
   info.factorizations = 1;  // K_A, as a direct solve's
@@ -300,7 +306,7 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
 }
 
 bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                                int maxRefinements, double reach, bool farStart) {
+                                int maxRefinements, double reach, bool farStart, double goal) {
   std::vector<compute::BoundSide> sides;
   if (!admm_->findActiveSides(sides)) return false;
   const Eigen::Index m = C_.rows();
@@ -330,7 +336,8 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
       }
     }
     compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho, maxRefinements,
-                                         kRoundingGoal * std::max(1.0, largestTarget), sides, true};
+                                         std::max(goal, kRoundingGoal * std::max(1.0, largestTarget)), sides,
+                                         true};
     request.reach = reach;
     request.farStart = farStart;
     compute::ActiveSetRefinementInfo refined;

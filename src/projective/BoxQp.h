@@ -85,8 +85,11 @@ struct BoxQpSettings : compute::AdmmSettings {
   /// (loosely solved: compute::ActiveSetRefinement::farStart). Measured on lavapipe,
   /// a 16x16 grid's deformation (first row fixed, far corner moved): from the last step's
   /// multipliers (residual 5e-4) the polish is at 4e-10 after 30 refinements and at rounding
-  /// (1e-14) after 60.
-  int equalityPolishIterations = 60;
+  /// (1e-14) after 60. On the 32x32 grid (1k faces) it stands after ~165 refinements
+  /// (1.3e-3 -> 4.5e-13), 4 101 PCG iterations against 10 735 for the ADMM and its polish
+  /// that solved the step when the cap was 60; on 48x48 (2.3k faces) it is given up either
+  /// way (its contraction too slow), 477 PCG iterations later than with 60.
+  int equalityPolishIterations = 200;
   /// Penalty of the polish's equality system; 0 picks kFactoredPolishRho where the backend
   /// factors SPD matrices (Backend::factorsSpdMatrices), kIterativePolishRho where it iterates.
   double polishRho = 0.0;
@@ -244,9 +247,10 @@ class BoxQpSolver {
   /// untouched: polish() then works from the downloaded iterate).
   /// At most maxRefinements per set; `reach` > 0 gives up a set's refinements that would
   /// not reach it (compute::ActiveSetRefinement::reach); `farStart` says the iterate is far
-  /// from the solution (compute::ActiveSetRefinement::farStart).
+  /// from the solution (compute::ActiveSetRefinement::farStart); a set's refinements stop
+  /// at a residual of `goal` or at rounding, whichever is larger.
   bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                     int maxRefinements, double reach = 0.0, bool farStart = false);
+                     int maxRefinements, double reach = 0.0, bool farStart = false, double goal = 0.0);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
   /// The direct solve of an all-equality problem (EqualitySolve::Direct) from
