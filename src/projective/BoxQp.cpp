@@ -239,7 +239,7 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
-  if (polishing && polishInPlace(lower, upper, info, settings_.polishIterations)) {
+  if (polishing && polishInPlace(lower, upper, info, settings_.inPlacePolishIterations)) {
     return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
   }
   if (polishing) {

@@ -1728,7 +1728,7 @@ TEST_F(VulkanAdmm, AWarmStartedExactStepIsSolvedByTheDevicesPolishAloneWithTheCp
 TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFromTheSameStart) {
   // One refinement leaves the polish's residual far above rounding: the device discards it
   // and the ADMM solves the step from the warm start, then polishes as usual. The ADMM's
-  // polish keeps its own cap (BoxQpSettings::polishIterations): it reaches rounding.
+  // polish keeps its own cap (BoxQpSettings::inPlacePolishIterations): it reaches rounding.
   GlobalStepCase problem(8);
   problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
   problem.settings.qp.equalityPolishIterations = 1;
@@ -1741,7 +1741,7 @@ TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFr
   EXPECT_GT(device.admmIterations, 0);
   // The discarded refinement, then the ADMM's polish.
   EXPECT_GT(device.polishRefinements, 2);
-  EXPECT_LE(device.polishRefinements, 1 + problem.settings.qp.polishIterations);
+  EXPECT_LE(device.polishRefinements, 1 + problem.settings.qp.inPlacePolishIterations);
   EXPECT_LT(device.constraintResidual, 1e-12);
   EXPECT_LT(both.mapDifference(), 1e-10);
 }
