@@ -815,6 +815,15 @@ Index polishActiveSet(const BoxQp& qp, const AdmmRun& admm, std::vector<char>& a
   return bounds;
 }
 
+/// polishActiveSet of the device ADMM's solution of qp (multi-dispatch recording).
+void admmActiveSet(vk::Context& context, const BoxQp& qp, const compute::AdmmSettings& settings,
+                   std::vector<char>& active, Eigen::MatrixXd& targets) {
+  auto solver = deviceSolver(context, qp, settings, kRecordings[1]);
+  const AdmmRun admm = runAdmm(*solver, qp);
+  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+  polishActiveSet(qp, admm, active, targets);
+}
+
 TEST_F(VulkanAdmm, ThePolishRefinesTheIterateOnTheDeviceToTheActiveSetSolutionMovingNoMatrix) {
   // The single-workgroup recording (fast on small problems): the polish records its own
   // multi-dispatch PCG in either.
@@ -877,12 +886,7 @@ TEST_F(VulkanAdmm, ARefinementPastTheSolutionStopsItsSolveAtTheRoundingFloor) {
   const compute::AdmmSettings settings;
   std::vector<char> active;
   Eigen::MatrixXd targets;
-  {
-    auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
-    const AdmmRun admm = runAdmm(*solver, qp);
-    ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
-    polishActiveSet(qp, admm, active, targets);
-  }
+  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context(), qp, settings, active, targets));
   Eigen::MatrixXd xReference, yReference;
   activeSetReference(qp, active, targets, xReference, yReference);
   Eigen::MatrixXd x, y;
@@ -962,12 +966,7 @@ TEST_F(VulkanAdmm, AFarStartSolvesItsPlainRefinementsLooselyAndReachesTheSameSol
   const compute::AdmmSettings settings;
   std::vector<char> active;
   Eigen::MatrixXd targets;
-  {
-    auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
-    const AdmmRun admm = runAdmm(*solver, qp);
-    ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
-    polishActiveSet(qp, admm, active, targets);
-  }
+  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context(), qp, settings, active, targets));
   for (Index i = 0; i < targets.rows(); ++i) targets(i, 0) += 1e-3 * std::cos(static_cast<double>(3 * i));
   Eigen::MatrixXd xReference, yReference;
   activeSetReference(qp, active, targets, xReference, yReference);
