@@ -193,9 +193,11 @@ void BlockMultigrid::buildSmoothed(const BlockAggregation& aggregation, const Sp
   std::vector<SparseMatrix> levels{K};
   levels.front().makeCompressed();
   std::vector<SparseMatrix> prolongations;
+  std::vector<std::vector<Eigen::MatrixXd>> inverses;
   for (int l = 0; l + 1 < aggregation.levelCount(); ++l) {
     const SparseMatrix& A = levels.back();
-    const SparseMatrix DinverseA = blockJacobiScaled(A, inverseDiagonalBlocks(A, b, l), b);
+    inverses.push_back(inverseDiagonalBlocks(A, b, l));
+    const SparseMatrix DinverseA = blockJacobiScaled(A, inverses.back(), b);
     const double omega = 4.0 / (3.0 * largestEigenvalue(DinverseA));
     const SparseMatrix Z = aggregation.prolongation(l);
     SparseMatrix P = Z - SparseMatrix(DinverseA * Z) * omega;
@@ -205,7 +207,7 @@ void BlockMultigrid::buildSmoothed(const BlockAggregation& aggregation, const Sp
     prolongations.push_back(std::move(P));
     levels.push_back(std::move(coarse));
   }
-  build(aggregation, std::move(levels), smootherDamping);
+  build(aggregation, std::move(levels), smootherDamping, std::move(inverses));
   for (std::size_t l = 0; l < prolongations.size(); ++l) levels_[l].prolongation = std::move(prolongations[l]);
 }
 
@@ -215,7 +217,7 @@ BlockMultigrid::BlockMultigrid(const BlockAggregation& aggregation, std::vector<
 }
 
 void BlockMultigrid::build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels,
-                           double smootherDamping) {
+                           double smootherDamping, std::vector<std::vector<Eigen::MatrixXd>> inverses) {
   block_ = aggregation.block();
   const int b = block_;
   if (static_cast<int>(levels.size()) != aggregation.levelCount()) {
@@ -227,7 +229,8 @@ void BlockMultigrid::build(const BlockAggregation& aggregation, std::vector<Spar
     Level level{std::move(levels[l]), {}, {}, {}};
     if (l + 1 < aggregation.levelCount()) {
       level.aggregate = aggregation.aggregates(l);
-      level.inverseBlocks = inverseDiagonalBlocks(level.K, b, l);
+      level.inverseBlocks = static_cast<std::size_t>(l) < inverses.size() ? std::move(inverses[l])
+                                                                            : inverseDiagonalBlocks(level.K, b, l);
       for (Eigen::MatrixXd& inverse : level.inverseBlocks) inverse *= smootherDamping;
     }
     levels_.push_back(std::move(level));

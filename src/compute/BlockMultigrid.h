@@ -114,7 +114,10 @@ class BlockMultigrid {
     SparseMatrix prolongation;                   ///< Smoothed P (empty: the aggregates' copy Z).
   };
   void buildSmoothed(const BlockAggregation& aggregation, const SparseMatrix& K, double smootherDamping);
-  void build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels, double smootherDamping);
+  /// `inverses`: each level's undamped diagonal-block inverses where the caller has them
+  /// (buildSmoothed), else empty and computed here.
+  void build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels, double smootherDamping,
+             std::vector<std::vector<Eigen::MatrixXd>> inverses = {});
   Eigen::VectorXd cycle(int level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd smooth(const Level& level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd restrictToCoarse(const Level& level, Index coarseRows, const Eigen::VectorXd& r) const;

@@ -200,7 +200,7 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // iterations against ~20) would cost as much as a whole momentum cycle's others. Only a
   // tightly solved plain refinement decides the rounding floor: a loose one that does not
   // reduce the residual is followed by one. From a far start (ActiveSetRefinement::farStart)
-  // every plain refinement is solved loosely so, the first ones included: there the first
+  // every plain refinement is solved loosely too, the first ones included: there the first
   // three tight ones took ~470 of a 16x16 grid's ~1 500 PCG iterations per step, and loose
   // ones reduce the residual as much (5.4e-4 -> 2.1e-4 -> 1.7e-4 either way).
   bool looseRestart = request.farStart;
