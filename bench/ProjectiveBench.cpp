@@ -258,7 +258,8 @@ plano::compute::SparseMatrix compatibilityMatrix(const plano::projective::ShapeS
 }
 
 /// One aggregation V-cycle (compute/BlockMultigrid.h, the global step's preconditioner
-/// above 64 faces) for three right-hand sides on the exact step's matrix
+/// above 64 faces; plain, or smoothed: BlockMultigridSettings::smoothProlongation) for three
+/// right-hand sides on the exact step's matrix
 /// K = I + sigma I + rho C^T C of a grid (every row an equality row; rho = 1e3, between the
 /// 0.1 x 1e3 the ADMM's equality rows start at and the few 1e3 they reach): the host reference, one column after the other, or
 /// the device's recorded cycle (vk::Multigrid) with K's levels and block inverses in place.
@@ -283,7 +284,7 @@ struct ExactStepMatrices {
   }
 };
 
-void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
+void BM_MultigridCycle(benchmark::State& state, BackendChoice choice, bool smoothed) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
@@ -294,8 +295,10 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
   const double rho = ExactStepMatrices::rho;
   const plano::compute::BlockAggregation aggregation(K, {4});
   const Eigen::MatrixXd r = plano::bench::jittered(Eigen::MatrixXd::Zero(K.rows(), 3), 1.0);
+  plano::compute::BlockMultigridSettings settings{4};
+  settings.smoothProlongation = smoothed;
   if (choice == BackendChoice::Cpu) {
-    const plano::compute::BlockMultigrid cycle(aggregation, aggregation.coarsen(K));
+    const plano::compute::BlockMultigrid cycle(aggregation, K, settings);
     memory.markLoopStart();
     for (auto _ : state) {
       for (Eigen::Index j = 0; j < r.cols(); ++j) benchmark::DoNotOptimize(cycle.apply(r.col(j)).data());
@@ -304,7 +307,7 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
     try {
       plano::vk::Context& context = static_cast<plano::compute::VulkanBackend*>(backend)->context();
       plano::vk::LinearAlgebra algebra(context);
-      plano::vk::Multigrid multigrid(context, algebra, aggregation, K0, K0);
+      plano::vk::Multigrid multigrid(context, algebra, aggregation, K0, K0, smoothed);
       multigrid.setK1(K1);
       plano::vk::DeviceCsrMatrix deviceK(context, K);
       plano::vk::Array<double> inverses(context, static_cast<std::size_t>(K.rows()) * 4,
@@ -318,7 +321,7 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
       plano::vk::Sequence setup(context);
       setup.begin();
       algebra.invertDiagonalBlocks(setup, deviceK, 4, inverses, failure);
-      multigrid.setRho(setup, rho, failure);
+      multigrid.setRho(setup, rho, deviceK, inverses, failure);
       setup.end();
       setup.run();
       const auto binding = multigrid.bind(deviceK, inverses, input, output);
@@ -336,6 +339,46 @@ void BM_MultigridCycle(benchmark::State& state, BackendChoice choice) {
   state.counters["levels"] = aggregation.levelCount();
   state.counters["rows"] = static_cast<double>(K.rows());
   state.counters["nonzeros"] = static_cast<double>(K.nonZeros());
+}
+
+/// One rho update of the device cycle (vk::Multigrid::setRho) on the exact step's K of a
+/// grid: the plain cycle assembles K0_l + rho K1_l and inverts blocks; the smoothed one
+/// forms every level's P and P^T K P from K (vk::SmoothedTransfer), the price of its fewer
+/// PCG iterations, paid at each rho update and each new K1.
+void BM_MultigridUpdate(benchmark::State& state, bool smoothed) {
+  plano::compute::Backend* backend = plano::bench::backendOrSkip(state, BackendChoice::Vulkan);
+  if (!backend) return;
+  plano::bench::MemoryCounters memory(state, backend);
+  const plano::PolygonMesh mesh = plano::bench::quadMesh(state.range(0));
+  const plano::projective::ShapeSpace space(mesh);
+  const ExactStepMatrices matrices(space);
+  const plano::compute::BlockAggregation aggregation(matrices.K, {4});
+  try {
+    plano::vk::Context& context = static_cast<plano::compute::VulkanBackend*>(backend)->context();
+    plano::vk::LinearAlgebra algebra(context);
+    plano::vk::Multigrid multigrid(context, algebra, aggregation, matrices.K0, matrices.K0, smoothed);
+    multigrid.setK1(matrices.K1);
+    plano::vk::DeviceCsrMatrix deviceK(context, matrices.K);
+    plano::vk::Array<double> inverses(context, static_cast<std::size_t>(matrices.K.rows()) * 4,
+                                      plano::vk::MemoryClass::Device, "block inverses");
+    plano::vk::Array<std::uint32_t> failure(context, 1, plano::vk::MemoryClass::Host, "failure");
+    const std::uint32_t none = ~0u;
+    failure.upload({&none, 1});
+    plano::vk::Sequence update(context);
+    update.begin();
+    algebra.invertDiagonalBlocks(update, deviceK, 4, inverses, failure);
+    multigrid.setRho(update, ExactStepMatrices::rho, deviceK, inverses, failure);
+    update.end();
+    plano::bench::timeSequence(state, update, [&] { memory.markLoopStart(); });
+    std::uint32_t failed = 0;
+    failure.download({&failed, 1});
+    if (failed != none) state.SkipWithError("a level was not positive definite");
+  } catch (const plano::Error& e) {  // e.g. larger than lavapipe's 2 GiB heap
+    state.SkipWithError(e.what());
+    return;
+  }
+  plano::bench::setFaceCounters(state, mesh);
+  state.counters["levels"] = aggregation.levelCount();
 }
 
 /// Eigen's ConjugateGradient preconditioner that applies one V-cycle (set after compute()).
@@ -535,10 +578,14 @@ BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_solver, BackendChoice::Vulkan, Solve
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_AdmmSetup, vulkan_kept_scales, BackendChoice::Vulkan, SolverReuse::KeptScales)
     ->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::standardSizes);
-BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu)->Apply(plano::bench::largeSizes);
-BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::standardSizes);
-BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu, false)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, cpu, BackendChoice::Cpu, false)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan, false)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan, BackendChoice::Vulkan, false)->Apply(plano::bench::largeSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, cpu_smoothed, BackendChoice::Cpu, true)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridCycle, vulkan_smoothed, BackendChoice::Vulkan, true)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridUpdate, plain, false)->Apply(plano::bench::standardSizes);
+BENCHMARK_CAPTURE(BM_MultigridUpdate, smoothed, true)->Apply(plano::bench::standardSizes);
 BENCHMARK_CAPTURE(BM_MultigridPcg, plain, false)->Apply(plano::bench::standardSizes);
 BENCHMARK_CAPTURE(BM_MultigridPcg, smoothed, true)->Apply(plano::bench::standardSizes);
 BENCHMARK(BM_WholeInverse)->Arg(16)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);

@@ -145,6 +145,13 @@ struct AdmmSettings {
   /// several times fewer PCG iterations with their group as a block.
   int preconditionerBlock = 1;
   AdmmPreconditioner preconditioner = AdmmPreconditioner::BlockJacobi;
+  /// The multigrid preconditioner's prolongations smoothed (BlockMultigridSettings::
+  /// smoothProlongation), its coarse levels formed on the device from K at each rho update:
+  /// about half the PCG iterations of the plain cycle. Its solves leave their error in K's
+  /// small eigenvalues, so pair it with a smaller linearToleranceFraction (the global step
+  /// uses 1e-3): at 1e-2 a 256-face exact step drifted from the host's 20 ADMM iterations to
+  /// 30 (VulkanAdmm.SmoothedMultigridKeepsTheHostIterationWithFewerPcgIterationsThanThePlainCycle).
+  bool smoothedMultigrid = false;
 };
 
 enum class AdmmStatus {

@@ -178,27 +178,33 @@ std::vector<SparseMatrix> BlockAggregation::coarsen(const SparseMatrix& A) const
   return levels;
 }
 
-BlockMultigrid::BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings) {
-  const BlockAggregation aggregation(K, settings);
+BlockMultigrid::BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings)
+    : BlockMultigrid(BlockAggregation(K, settings), K, settings) {}
+
+BlockMultigrid::BlockMultigrid(const BlockAggregation& aggregation, const SparseMatrix& K,
+                               const BlockMultigridSettings& settings) {
   if (settings.smoothProlongation) {
-    buildSmoothed(aggregation, K, settings.smootherDamping);
+    buildSmoothed(aggregation, K, settings);
   } else {
     build(aggregation, aggregation.coarsen(K), settings.smootherDamping);
   }
 }
 
 void BlockMultigrid::buildSmoothed(const BlockAggregation& aggregation, const SparseMatrix& K,
-                                   double smootherDamping) {
+                                   const BlockMultigridSettings& settings) {
   const int b = aggregation.block();
   std::vector<SparseMatrix> levels{K};
   levels.front().makeCompressed();
   std::vector<SparseMatrix> prolongations;
   std::vector<std::vector<Eigen::MatrixXd>> inverses;
+  std::vector<double> dampings;
   for (int l = 0; l + 1 < aggregation.levelCount(); ++l) {
     const SparseMatrix& A = levels.back();
     inverses.push_back(inverseDiagonalBlocks(A, b, l));
     const SparseMatrix DinverseA = blockJacobiScaled(A, inverses.back(), b);
-    const double omega = 4.0 / (3.0 * largestEigenvalue(DinverseA));
+    const double lambda = largestEigenvalue(DinverseA);
+    const double omega = 4.0 / (3.0 * lambda);
+    dampings.push_back(std::min(settings.smootherDamping, settings.smootherSpectralBound / lambda));
     const SparseMatrix Z = aggregation.prolongation(l);
     SparseMatrix P = Z - SparseMatrix(DinverseA * Z) * omega;
     P.prune(0.0);
@@ -207,7 +213,7 @@ void BlockMultigrid::buildSmoothed(const BlockAggregation& aggregation, const Sp
     prolongations.push_back(std::move(P));
     levels.push_back(std::move(coarse));
   }
-  build(aggregation, std::move(levels), smootherDamping, std::move(inverses));
+  build(aggregation, std::move(levels), settings.smootherDamping, std::move(inverses), std::move(dampings));
   for (std::size_t l = 0; l < prolongations.size(); ++l) levels_[l].prolongation = std::move(prolongations[l]);
 }
 
@@ -217,7 +223,8 @@ BlockMultigrid::BlockMultigrid(const BlockAggregation& aggregation, std::vector<
 }
 
 void BlockMultigrid::build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels,
-                           double smootherDamping, std::vector<std::vector<Eigen::MatrixXd>> inverses) {
+                           double smootherDamping, std::vector<std::vector<Eigen::MatrixXd>> inverses,
+                           std::vector<double> dampings) {
   block_ = aggregation.block();
   const int b = block_;
   if (static_cast<int>(levels.size()) != aggregation.levelCount()) {
@@ -231,7 +238,8 @@ void BlockMultigrid::build(const BlockAggregation& aggregation, std::vector<Spar
       level.aggregate = aggregation.aggregates(l);
       level.inverseBlocks = static_cast<std::size_t>(l) < inverses.size() ? std::move(inverses[l])
                                                                             : inverseDiagonalBlocks(level.K, b, l);
-      for (Eigen::MatrixXd& inverse : level.inverseBlocks) inverse *= smootherDamping;
+      const double damping = static_cast<std::size_t>(l) < dampings.size() ? dampings[l] : smootherDamping;
+      for (Eigen::MatrixXd& inverse : level.inverseBlocks) inverse *= damping;
     }
     levels_.push_back(std::move(level));
   }

@@ -40,16 +40,24 @@ struct BlockMultigridSettings {
   /// and the coarse matrices are P^T K P. The near-null space of C^T rho C (the compatible
   /// map fields, which vary from face to face) is then interpolated linearly instead of
   /// piecewise constantly, and the PCG iterations stop growing with the mesh. Measured
-  /// on the global step's matrices, rho_eq 1e3 (plain -> smoothed): 1k faces 25 -> 16, 4k
-  /// 31 -> 14, 16k 45 -> 13, 65k 61 -> 13; rho_eq 1e5: 142 -> 108, 114 -> 50, 94 -> 29, 86 -> 19.
-  /// The price is denser coarse levels (65k faces: operator complexity 2.3-2.5 against 1.3,
-  /// P with ~14 entries a row) and a costlier setup: on the host, BM_MultigridPcg's
-  /// simpler exact-step matrix (plain -> smoothed: 25 -> 13 iterations on 4k faces, 26 -> 12
-  /// on 65k) takes 2.1-2.6x the time per PCG iteration, so there the smoothed solve is the
-  /// slower one (33 -> 37 ms, 631 -> 764 ms). Host only, off by default: the device's cycle
-  /// (vk::Multigrid) coarsens with Z; whether the real steps' larger cut pays on a GPU is
-  /// open.
+  /// on the global step's matrices, rho_eq 1e3 (plain -> smoothed): 1k faces 25 -> 13, 4k
+  /// 31 -> 10, 16k 45 -> 10, 65k 61 -> 10; rho_eq 1e5: 142 -> 87, 114 -> 50, 94 -> 27, 86 -> 16.
+  /// The price is denser coarse levels (65k faces: operator complexity 2.3 against 1.3)
+  /// and a costlier setup; on the host the smoothed solve of BM_MultigridPcg is the slower
+  /// one (2.1-2.6x the time per iteration for half the iterations), so the host reference
+  /// keeps it off by default. The device's cycle forms it at each rho update
+  /// (vk::SmoothedTransfer; AdmmSettings::smoothedMultigrid, on in the global step).
   bool smoothProlongation = false;
+  /// With smoothProlongation: each level's smoother damping is at most this bound over
+  /// lambda_max(D^-1 K) (the estimate that sets omega). The symmetric V-cycle is positive
+  /// definite only where the damped smoother converges (damping * lambda_max < 2), and the
+  /// smoothed coarse levels have lambda_max above 2 (2.0-2.4 on the global step's matrices
+  /// at rho_eq 1e5, 16x16 to 48x48 grids). Undamped, the 16x16 cycle's M K had an eigenvalue
+  /// of -0.07 at rho_eq 1e5, and the device's PCG stopped a few iterations in, far from the
+  /// solution; with this bound M K's spectrum is [0.0073, 1] there and [0.73, 1] at rho_eq
+  /// 1e2 (plain aggregation: [0.0040, 1], [0.36, 1]). The power iteration estimates lambda
+  /// from below: 1.5 leaves a quarter's margin to 2 (1.9 gives [0.0085, 1] but none).
+  double smootherSpectralBound = 1.5;
 };
 
 /// Pair every block with its most strongly coupled unpaired neighbour (coupling:
@@ -90,6 +98,10 @@ class BlockMultigrid {
   /// Error(Numerical) when a diagonal block or the coarsest matrix is not positive definite.
   /// With settings.smoothProlongation, the smoothed-aggregation cycle over K's aggregation.
   explicit BlockMultigrid(const SparseMatrix& K, const BlockMultigridSettings& settings = {});
+  /// The cycle of K over a given aggregation (that of another matrix of K's structure, as
+  /// the device's cycle keeps it for every rho); settings.block and the coarsening limits
+  /// are the aggregation's.
+  BlockMultigrid(const BlockAggregation& aggregation, const SparseMatrix& K, const BlockMultigridSettings& settings);
   /// The cycle of `levels` (one matrix per level of `aggregation`).
   BlockMultigrid(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels,
                  double smootherDamping = BlockMultigridSettings{}.smootherDamping);
@@ -113,11 +125,12 @@ class BlockMultigrid {
     std::vector<Index> aggregate;                ///< Block -> coarse block (empty on the coarsest).
     SparseMatrix prolongation;                   ///< Smoothed P (empty: the aggregates' copy Z).
   };
-  void buildSmoothed(const BlockAggregation& aggregation, const SparseMatrix& K, double smootherDamping);
+  void buildSmoothed(const BlockAggregation& aggregation, const SparseMatrix& K, const BlockMultigridSettings& settings);
   /// `inverses`: each level's undamped diagonal-block inverses where the caller has them
-  /// (buildSmoothed), else empty and computed here.
+  /// (buildSmoothed), else empty and computed here; `dampings` each level's smoother damping
+  /// where the caller chose them (else smootherDamping everywhere).
   void build(const BlockAggregation& aggregation, std::vector<SparseMatrix> levels, double smootherDamping,
-             std::vector<std::vector<Eigen::MatrixXd>> inverses = {});
+             std::vector<std::vector<Eigen::MatrixXd>> inverses = {}, std::vector<double> dampings = {});
   Eigen::VectorXd cycle(int level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd smooth(const Level& level, const Eigen::VectorXd& r) const;
   Eigen::VectorXd restrictToCoarse(const Level& level, Index coarseRows, const Eigen::VectorXd& r) const;

@@ -3,6 +3,7 @@
 // matrix once and refill its values every iteration (planarizers, device kernels) keep the
 // position of each value among the stored entries instead of searching again.
 #include <cstdint>
+#include <vector>
 
 #include "compute/Backend.h"
 
@@ -11,5 +12,13 @@ namespace plano::compute {
 /// Position of entry (row, column) among the stored entries of the compressed A, or -1 when
 /// that entry is not stored.
 std::int32_t storedEntryIndex(const SparseMatrix& A, Index row, Index column);
+
+/// For each stored value of the compressed A, its position among A^T's stored values (the
+/// gather that transposes values on a device).
+std::vector<std::int32_t> transposeTargets(const SparseMatrix& A);
+
+/// A's pattern with every stored value 1: products of such patterns have no cancellation,
+/// so they hold every entry a product of the matrices can have.
+SparseMatrix ones(const SparseMatrix& A);
 
 }  // namespace plano::compute

@@ -86,19 +86,6 @@ K1Terms k1Terms(const compute::SparseMatrix& C, const compute::SparseMatrix& K) 
   return terms;
 }
 
-/// For each stored value of C, its position among C^T's (the gather that transposes values).
-std::vector<std::int32_t> transposeTargets(const compute::SparseMatrix& C) {
-  compute::SparseMatrix positions = C;
-  for (Eigen::Index e = 0; e < positions.nonZeros(); ++e) positions.valuePtr()[e] = static_cast<double>(e);
-  compute::SparseMatrix transposed = positions.transpose();
-  transposed.makeCompressed();
-  std::vector<std::int32_t> targets(static_cast<std::size_t>(C.nonZeros()));
-  for (Eigen::Index t = 0; t < transposed.nonZeros(); ++t) {
-    targets[static_cast<std::size_t>(transposed.valuePtr()[t])] = static_cast<std::int32_t>(t);
-  }
-  return targets;
-}
-
 /// Upload `values` to `device` unless `held` (what it holds) equals them: the attempts of
 /// an ε schedule share q and the bounds' centre.
 void uploadIfChanged(DeviceVectors& device, Eigen::MatrixXd& held, const Eigen::MatrixXd& values) {
@@ -190,7 +177,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     k1TermB_ = uploaded(context, terms.b, "ADMM K1 terms");
     cEntryRows_ = uploaded(context, terms.entryRows, "ADMM C entry rows");
   }
-  transpose_ = std::make_unique<DeviceGather>(context, transposeTargets(C_),
+  transpose_ = std::make_unique<DeviceGather>(context, compute::transposeTargets(C_),
                                               elementCount(Ct_.nonZeros(), "C's entries"), "ADMM C^T values");
   valuesUpdate_.begin();
   algebra_.gatherSum(valuesUpdate_, *transpose_, devC_.values(), devCt_.values());
@@ -241,7 +228,7 @@ AdmmKernels::AdmmKernels(Context& context, const compute::SparseMatrix& P, const
     } else if (recording_ == AdmmRecording::SingleWorkgroup && aggregation_->levelCount() > 1) {
       aggregation_.reset();  // Automatic: a cycle this recording cannot run; face blocks
     } else {
-      multigrid_ = std::make_unique<Multigrid>(context_, algebra_, *aggregation_, K0_, K0_);
+      multigrid_ = std::make_unique<Multigrid>(context_, algebra_, *aggregation_, K0_, K0_, settings_.smoothedMultigrid);
     }
   }
 }
@@ -318,7 +305,7 @@ void AdmmKernels::assembleK(double rho) {
   algebra_.invertDiagonalBlocks(assembly_, devK_, block_, inverseBlocks_, blockFailure_);
   if (multigrid_) {
     coarseFailure_.upload({&noFailure, 1});
-    multigrid_->setRho(assembly_, rho, coarseFailure_);
+    multigrid_->setRho(assembly_, rho, devK_, inverseBlocks_, coarseFailure_);
   }
   assembly_.end();
   assembly_.run();

@@ -192,6 +192,15 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
   // (the 11th): by then the first momentum cycle has shown the contraction (the first two
   // are plain ones that reduce the fast modes, and would promise too much).
   constexpr int kReachJudgedFrom = 10;
+  // A polish with no reach (the accuracy polish after an ADMM solve) whose best residual
+  // fell by less than half over the last kStagnationWindow refinements, within
+  // kNearRoundingFloor of its goal, has met the rounding floor: the 2.3k-face grid's first
+  // step ran into its 200-refinement cap there, residual 5.1e-14 -> 3.7e-14 over its last
+  // 70 refinements (goal 1e-15), about 500 PCG iterations for nothing. Far above the goal
+  // a slow contraction still pays (BoxQpSettings::inPlacePolishIterations).
+  constexpr int kStagnationWindow = 10;
+  constexpr double kNearRoundingFloor = 1e3;
+  std::vector<double> bestSoFar;
   double first = 0.0, best = std::numeric_limits<double>::infinity();
   int sinceRestart = 0;
   bool accelerate = false;
@@ -232,6 +241,11 @@ bool AdmmKernels::refineActiveSet(const compute::ActiveSetRefinement& request, E
     if (!(residual > request.goal)) break;  // NaN too: the caller rejects it
     if (r == 0) first = residual;
     best = std::min(best, residual);
+    bestSoFar.push_back(best);
+    if (request.reach == 0.0 && r >= kStagnationWindow && best < kNearRoundingFloor * request.goal &&
+        best > 0.5 * bestSoFar[r - kStagnationWindow]) {
+      break;
+    }
     if (request.reach > 0.0 && r >= kReachJudgedFrom) {
       // The mean contraction per refinement so far (from the best residual: the momentum's
       // overshoots come back), over the refinements left.

@@ -39,13 +39,6 @@ std::uint32_t inversionGroups(const Context& context, std::uint32_t rows) {
   return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(groups, 1, std::max<std::uint32_t>(rows, 1)));
 }
 
-/// A's pattern with every stored value 1 (no cancellation when coarsened).
-compute::SparseMatrix ones(const compute::SparseMatrix& A) {
-  compute::SparseMatrix pattern = A;
-  for (Eigen::Index e = 0; e < pattern.nonZeros(); ++e) pattern.valuePtr()[e] = 1.0;
-  return pattern;
-}
-
 /// A on `pattern` (explicit zeros where A has no entry); Error(Device) when A has an entry
 /// outside it.
 compute::SparseMatrix onPattern(const compute::SparseMatrix& A, const compute::SparseMatrix& pattern) {
@@ -89,7 +82,7 @@ struct Multigrid::Level {
 
 /// Descriptor sets of one level's steps.
 struct LevelSets {
-  std::unique_ptr<DescriptorSet> smoothDown, restrictResidual, prolongFrom, residual, smoothUp;
+  std::unique_ptr<DescriptorSet> smoothDown, residualDown, restrictResidual, prolongFrom, residual, smoothUp;
 };
 
 struct Multigrid::Binding::Sets {
@@ -101,12 +94,15 @@ Multigrid::Binding::Binding() : sets_(std::make_unique<Sets>()) {}
 Multigrid::Binding::~Binding() = default;
 
 Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::BlockAggregation& aggregation,
-                     const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern)
+                     const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern,
+                     bool smoothProlongation)
     : context_(context),
       algebra_(algebra),
       block_(static_cast<std::uint32_t>(aggregation.block())),
       columns_(0),
       aggregation_(aggregation),
+      smoothed_(smoothProlongation && aggregation.levelCount() > 1),
+      spmvAdd_(context, "la_spmv_add", 5, sizeof(SpmvPush)),
       spmv_(context, "la_spmv", 5, sizeof(SpmvPush)),
       scale_(context, "la_scale_rows", 3, sizeof(ScalePush)),
       residual_(context, "la_residual", 6, sizeof(SpmvPush)),
@@ -118,13 +114,24 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       coarsestInvert_(context, "mg_coarsest_invert", 3, sizeof(CoarsestInvertPush), singleWorkgroupLanes(context)),
       noRows_(context, 1, MemoryClass::Device, "multigrid unused rows") {
   const int L = aggregation_.levelCount();
-  const std::vector<compute::SparseMatrix> patternLevels = aggregation_.coarsen(ones(pattern));
-  const std::vector<compute::SparseMatrix> k0Levels = aggregation_.coarsen(onPattern(K0, pattern));
+  std::vector<compute::SparseMatrix> patternLevels, k0Levels;
+  if (smoothed_) {
+    patternLevels.push_back(compute::ones(pattern));
+    for (int l = 0; l + 1 < L; ++l) {
+      transfers_.push_back(std::make_unique<SmoothedTransfer>(context, algebra, patternLevels[l],
+                                                              aggregation_.aggregates(l), aggregation_.blocks(l + 1),
+                                                              block_));
+      patternLevels.push_back(transfers_.back()->coarsePattern());
+    }
+  } else {
+    patternLevels = aggregation_.coarsen(compute::ones(pattern));
+    k0Levels = aggregation_.coarsen(onPattern(K0, pattern));
+  }
   for (int l = 0; l < L; ++l) {
     auto level = std::make_unique<Level>();
     level->rows = elementCount(patternLevels[l].rows(), "a multigrid level's rows");
     const bool coarsest = l + 1 == L;
-    if (!coarsest) {
+    if (!coarsest && !smoothed_) {
       const std::vector<Index>& aggregate = aggregation_.aggregates(l);
       std::vector<std::int32_t> parents(aggregate.begin(), aggregate.end());
       std::vector<std::int32_t> offsets(aggregation_.blocks(l + 1) + 1, 0);
@@ -140,12 +147,16 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       level->children = std::make_unique<Array<std::int32_t>>(context, children.size(), MemoryClass::Device, "multigrid aggregate members");
       level->children->upload(children);
     }
-    if (l > 0 && !coarsest) {
+    if (l > 0 && !coarsest && smoothed_) {
+      level->K = std::make_unique<DeviceCsrMatrix>(context, patternLevels[l]);  // values from setRho
+    } else if (l > 0 && !coarsest) {
       const compute::SparseMatrix values = onPattern(k0Levels[l], patternLevels[l]);
       level->K = std::make_unique<DeviceCsrMatrix>(context, values);
       level->k0 = std::make_unique<Array<double>>(context, values.nonZeros(), MemoryClass::Device, "multigrid K0 values");
       level->k0->upload(valuesOf(values));
       level->k1 = std::make_unique<Array<double>>(context, values.nonZeros(), MemoryClass::Device, "multigrid K1 values");
+    }
+    if (l > 0 && !coarsest) {
       level->inverses = std::make_unique<Array<double>>(context, static_cast<std::size_t>(level->rows) * block_,
                                                         MemoryClass::Device, "multigrid block inverses");
     }
@@ -158,14 +169,16 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
       compute::SparseMatrix full = dense;
       full.makeCompressed();
       level->K = std::make_unique<DeviceCsrMatrix>(context, full);
-      coarsestK0_ = std::make_unique<DeviceCsrMatrix>(context, onPattern(k0Levels[l], patternLevels[l]));
+      // Smoothed: the coarsest K itself, written by the last transfer (its K1 part stays 0).
+      coarsestK0_ = std::make_unique<DeviceCsrMatrix>(
+          context, smoothed_ ? patternLevels[l] : onPattern(k0Levels[l], patternLevels[l]));
       sweepSaved_ = std::make_unique<Array<double>>(context, 2 * (std::size_t{level->rows} + 1), MemoryClass::Device,
                                                     "multigrid inversion's saved columns");
     }
     patterns_.push_back(patternLevels[l]);
     levels_.push_back(std::move(level));
   }
-  for (int l = 0; l + 1 < L; ++l) {
+  for (int l = 0; l + 1 < L && !smoothed_; ++l) {
     const std::vector<std::int32_t> targets =
         coarseEntries(patterns_[l], patterns_[l + 1], aggregation_.aggregates(l), block_);
     coarsenings_.push_back(std::make_unique<DeviceGather>(
@@ -174,6 +187,10 @@ Multigrid::Multigrid(Context& context, LinearAlgebra& algebra, const compute::Bl
   }
   coarsestK1Values_ = std::make_unique<Array<double>>(context, static_cast<std::size_t>(patterns_.back().nonZeros()),
                                                       MemoryClass::Device, "multigrid coarsest K1 values");
+  if (smoothed_) {
+    const std::vector<double> zeros(coarsestK1Values_->count(), 0.0);
+    coarsestK1Values_->upload(zeros);
+  }
 }
 
 Multigrid::~Multigrid() = default;
@@ -184,6 +201,7 @@ const Array<double>* Multigrid::wholeInverse() const {
 
 void Multigrid::setK1(Sequence& sequence, const Array<double>& k1) {
   k1Set_ = true;
+  if (smoothed_) return;  // coarse levels come from K itself (setRho)
   const int L = levelCount();
   if (L == 1) {
     sequence.copy(k1, *coarsestK1Values_, coarsestK1Values_->count() * sizeof(double));
@@ -208,7 +226,24 @@ void Multigrid::setK1(const compute::SparseMatrix& K1) {
   sequence.run();
 }
 
+void Multigrid::setRho(Sequence& sequence, double rho, const DeviceCsrMatrix& K, const Array<double>& inverses,
+                       Array<std::uint32_t>& failure) {
+  if (!smoothed_) {
+    setRho(sequence, rho, failure);
+    return;
+  }
+  const int L = levelCount();
+  for (int l = 0; l + 1 < L; ++l) {
+    const bool first = l == 0, lastTransfer = l + 2 == L;
+    DeviceCsrMatrix& coarse = lastTransfer ? *coarsestK0_ : *levels_[l + 1]->K;
+    transfers_[l]->record(sequence, first ? K : *levels_[l]->K, first ? inverses : *levels_[l]->inverses, coarse);
+    if (!lastTransfer) algebra_.invertDiagonalBlocks(sequence, coarse, block_, *levels_[l + 1]->inverses, failure);
+  }
+  recordCoarsestInverse(sequence, 0.0, failure);
+}
+
 void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure) {
+  if (smoothed_) throwUsage("smoothed multigrid: setRho needs level 0's K and block inverses");
   if (!k1Set_) throwUsage("multigrid: setRho before setK1");
   for (int l = 1; l + 1 < levelCount(); ++l) {
     Level& level = *levels_[l];
@@ -218,6 +253,10 @@ void Multigrid::setRho(Sequence& sequence, double rho, Array<std::uint32_t>& fai
     sequence.barrier();
     algebra_.invertDiagonalBlocks(sequence, *level.K, block_, *level.inverses, failure);
   }
+  recordCoarsestInverse(sequence, rho, failure);
+}
+
+void Multigrid::recordCoarsestInverse(Sequence& sequence, double rho, Array<std::uint32_t>& failure) {
   // The coarsest level: its dense inverse, in place of its dense K.
   const std::uint32_t rows = levels_.back()->rows;
   Array<double>& dense = levels_.back()->K->values();
@@ -258,17 +297,35 @@ std::unique_ptr<Multigrid::Binding> Multigrid::bind(const DeviceCsrMatrix& K, co
     Level& level = *levels_[l];
     Level& coarse = *levels_[l + 1];
     const DeviceCsrMatrix& matrix = l == 0 ? K : *level.K;
-    const Array<double>& inverses = l == 0 ? inverseBlocks : *level.inverses;
+    // The smoothed cycle's smoother is damped (SmoothedTransfer::smoother), the plain one's not.
+    const Array<double>& inverses =
+        smoothed_ ? transfers_[l]->smoother() : (l == 0 ? inverseBlocks : *level.inverses);
     const Array<double>& rl = l == 0 ? r.data() : level.r->data();
     const Array<double>& zl = l == 0 ? z.data() : level.z->data();
     LevelSets sets;
     sets.smoothDown = std::make_unique<DescriptorSet>(context_, scale_, std::initializer_list<BufferRange>{inverses, rl, zl});
-    sets.restrictResidual = std::make_unique<DescriptorSet>(
-        context_, restrictResidual_,
-        std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
-                                           *level.childOffsets, *level.children, coarse.r->data()});
-    sets.prolongFrom = std::make_unique<DescriptorSet>(
-        context_, prolong_, std::initializer_list<BufferRange>{*level.aggregates, coarse.z->data(), zl});
+    if (smoothed_) {
+      const DeviceCsrMatrix& P = transfers_[l]->P();
+      const DeviceCsrMatrix& Pt = transfers_[l]->transposedP();
+      sets.residualDown = std::make_unique<DescriptorSet>(
+          context_, residual_,
+          std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
+                                             level.t->data()});
+      sets.restrictResidual = std::make_unique<DescriptorSet>(
+          context_, spmv_,
+          std::initializer_list<BufferRange>{Pt.rowOffsets(), Pt.columns(), Pt.values(), level.t->data(),
+                                             coarse.r->data()});
+      sets.prolongFrom = std::make_unique<DescriptorSet>(
+          context_, spmvAdd_,
+          std::initializer_list<BufferRange>{P.rowOffsets(), P.columns(), P.values(), coarse.z->data(), zl});
+    } else {
+      sets.restrictResidual = std::make_unique<DescriptorSet>(
+          context_, restrictResidual_,
+          std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
+                                             *level.childOffsets, *level.children, coarse.r->data()});
+      sets.prolongFrom = std::make_unique<DescriptorSet>(
+          context_, prolong_, std::initializer_list<BufferRange>{*level.aggregates, coarse.z->data(), zl});
+    }
     sets.residual = std::make_unique<DescriptorSet>(
         context_, residual_,
         std::initializer_list<BufferRange>{matrix.rowOffsets(), matrix.columns(), matrix.values(), zl, rl,
@@ -302,15 +359,24 @@ void Multigrid::record(Sequence& sequence, const Binding& binding, const Buffer*
   for (int l = 0; l + 1 < L; ++l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, nc = levels_[l + 1]->rows;
-    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, n * k);                       // z = S r
-    run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, nc);  // r_c = Z^T (r - K z)
+    run(scale_, *sets.smoothDown, ScalePush{n, k, block_}, n * k);  // z = S r
+    if (smoothed_) {
+      run(residual_, *sets.residualDown, SpmvPush{n, n, k}, n);    // t = r - K z
+      run(spmv_, *sets.restrictResidual, SpmvPush{nc, n, k}, nc);  // r_c = P^T t
+    } else {
+      run(restrictResidual_, *sets.restrictResidual, TransferPush{n, nc, k, block_}, nc);  // r_c = Z^T (r - K z)
+    }
   }
   const std::uint32_t nc = levels_.back()->rows;
   run(spmv_, *binding.sets_->coarsest, SpmvPush{nc, nc, k}, nc);  // z_c = K_c^-1 r_c
   for (int l = L - 2; l >= 0; --l) {
     const LevelSets& sets = binding.sets_->levels[l];
     const std::uint32_t n = levels_[l]->rows, coarse = levels_[l + 1]->rows;
-    run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, n * k);  // z += Z z_c
+    if (smoothed_) {
+      run(spmvAdd_, *sets.prolongFrom, SpmvPush{n, coarse, k}, n);  // z += P z_c
+    } else {
+      run(prolong_, *sets.prolongFrom, TransferPush{n, coarse, k, block_}, n * k);  // z += Z z_c
+    }
     run(residual_, *sets.residual, SpmvPush{n, n, k}, n);                         // t = r - K z
     run(scaleAdd_, *sets.smoothUp, ScalePush{n, k, block_}, n * k);               // z += S t
   }

@@ -20,6 +20,9 @@
 // kernel; the coarsest z = K^-1 r; back up, z += Z z_coarse, t = r - K z, z += S t: five
 // dispatches per level but the coarsest (nine before the fused kernels: each product, each
 // subtraction and each smoothing update its own, with a pass over memory between them).
+// The smoothed cycle (constructor's smoothProlongation) restricts with P^T and prolongs
+// with P, six dispatches per level (z = S r, t = r - K z, r_c = P^T t; z += P z_c,
+// t = r - K z, z += S t), its smoother damped (vk::SmoothedTransfer).
 // Every dispatch is sized by
 // one caller-given indirect triple (x workgroups, 1, 1), so that inside a recorded PCG the
 // cycles of a converged solve cost empty dispatches; all kernels loop grid-stride, so any
@@ -29,6 +32,7 @@
 
 #include "compute/BlockMultigrid.h"
 #include "compute/vulkan/VulkanLinearAlgebra.h"
+#include "compute/vulkan/VulkanSmoothedTransfer.h"
 
 namespace plano::vk {
 
@@ -36,9 +40,11 @@ class Multigrid {
  public:
   /// The levels of `aggregation` for K0 (level 0 on the caller's pattern `pattern`, which
   /// must also hold K1's entries). `algebra` (the caller's, kept by reference) inverts the
-  /// coarse levels' blocks.
+  /// coarse levels' blocks. With `smoothProlongation`, the smoothed-aggregation cycle
+  /// (BlockMultigridSettings::smoothProlongation; vk::SmoothedTransfer): its coarse levels
+  /// come from level 0's K at each setRho, K0 and K1 are not coarsened.
   Multigrid(Context& context, LinearAlgebra& algebra, const compute::BlockAggregation& aggregation,
-            const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern);
+            const compute::SparseMatrix& K0, const compute::SparseMatrix& pattern, bool smoothProlongation = false);
   ~Multigrid();
   Multigrid(const Multigrid&) = delete;
   Multigrid& operator=(const Multigrid&) = delete;
@@ -60,6 +66,12 @@ class Multigrid {
   /// `sequence`. A coarse block that is not positive definite leaves its index in `failure`
   /// (set to ~0 by the caller), a coarsest level that is not, kCoarsestFailure.
   void setRho(Sequence& sequence, double rho, Array<std::uint32_t>& failure);
+  /// The same given level 0's K (on the caller's pattern, for this rho) and its undamped
+  /// block-Jacobi inverses, recorded earlier into `sequence`: the smoothed cycle forms its
+  /// coarse levels from them (the plain one ignores them).
+  void setRho(Sequence& sequence, double rho, const DeviceCsrMatrix& K, const Array<double>& inverses,
+              Array<std::uint32_t>& failure);
+  bool smoothed() const { return smoothed_; }
 
   /// The cycle's level-0 operands: input r, output z, K and its block inverses. Descriptor
   /// sets are built once per binding; a recording refers to it. The levels' vectors are
@@ -90,6 +102,8 @@ class Multigrid {
 
  private:
   struct Level;
+  /// The coarsest level's dense inverse from its K0 + rho K1 (its K, rho 0, when smoothed).
+  void recordCoarsestInverse(Sequence& sequence, double rho, Array<std::uint32_t>& failure);
 
   Context& context_;
   LinearAlgebra& algebra_;
@@ -102,7 +116,9 @@ class Multigrid {
   std::unique_ptr<DeviceCsrMatrix> coarsestK0_;            ///< The coarsest level's K0, on its pattern.
   std::unique_ptr<Array<double>> coarsestK1Values_;        ///< On the coarsest level's pattern.
   bool k1Set_ = false;
-  Pipeline spmv_, scale_, residual_, scaleAdd_, restrictResidual_, prolong_, assemble_, coarsestAssemble_,
+  bool smoothed_ = false;
+  std::vector<std::unique_ptr<SmoothedTransfer>> transfers_;  ///< Smoothed: level l -> l + 1.
+  Pipeline spmvAdd_, spmv_, scale_, residual_, scaleAdd_, restrictResidual_, prolong_, assemble_, coarsestAssemble_,
       coarsestInvert_;
   std::unique_ptr<Array<double>> sweepSaved_;  ///< The inversion's two saved pivot columns.
   Array<double> noRows_;  ///< admm_assemble's row buffers, unused on coarse levels.
