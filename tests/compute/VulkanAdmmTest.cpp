@@ -954,6 +954,40 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
   EXPECT_LE(fastWithReachResidual, kGoal);
 }
 
+TEST_F(VulkanAdmm, AStalledRefinementNearItsGoalStopsAtTheRoundingFloorAndFarFromItGoesOn) {
+  // A polish without a reach whose best residual falls by less than half over ten
+  // refinements stops there when it is within 1e3 of its goal (the rounding floor of a
+  // large step's polish), and goes on to its cap when it is further. A tiny penalty makes
+  // the method of multipliers stall from the start.
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  const compute::AdmmSettings settings;
+  auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
+  const AdmmRun admm = runAdmm(*solver, qp);
+  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+  std::vector<char> active;
+  Eigen::MatrixXd targets;
+  polishActiveSet(qp, admm, active, targets);
+  const auto refine = [&](int cap, double goal, double& residual) {
+    compute::ActiveSetRefinement request{active, targets, {0}, 1e-3, cap, goal, {}, false};
+    compute::ActiveSetRefinementInfo info;
+    Eigen::MatrixXd x, y;
+    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
+    residual = 0.0;
+    const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
+    for (Index i = 0; i < r.size(); ++i) {
+      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
+    }
+    return info.refinements;
+  };
+  double first = 0.0, near = 0.0, far = 0.0;
+  ASSERT_EQ(refine(1, 0.0, first), 1);
+  ASSERT_GT(first, 0.0);
+  EXPECT_EQ(refine(30, first / 100, near), 11) << "stalled within 1e3 of the goal: stops after ten more";
+  EXPECT_GT(near, 0.5 * first / 100) << "the residual did not stall";
+  EXPECT_EQ(refine(30, first / 1e5, far), 30) << "further from the goal: the cap";
+  EXPECT_GT(far, first / 1e5);
+}
+
 TEST_F(VulkanAdmm, AFarStartSolvesItsPlainRefinementsLooselyAndReachesTheSameSolutionWithFewerPcgIterations) {
   // ActiveSetRefinement::farStart: targets moved by 1e-3 from the ADMM's (as a loop's next
   // exact step moves them) put the start far from the active-set solution. With rho 1000 the
