@@ -908,6 +908,21 @@ TEST_F(VulkanAdmm, ARefinementPastTheSolutionStopsItsSolveAtTheRoundingFloor) {
       << fourth.linearIterations << " PCG iterations in all";
 }
 
+/// The refinements `request` (of column 0, from the solver's iterate) ran, and in
+/// `residual` the largest violation of its active rows after them.
+int refineColumnZero(compute::AdmmSolver& solver, const BoxQp& qp, const compute::ActiveSetRefinement& request,
+                     double& residual) {
+  compute::ActiveSetRefinementInfo info;
+  Eigen::MatrixXd x, y;
+  EXPECT_TRUE(solver.refineActiveSet(request, x, y, info));
+  residual = 0.0;
+  const Eigen::VectorXd r = qp.C * x.col(0) - request.targets.col(0);
+  for (Index i = 0; i < r.size(); ++i) {
+    if (request.active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
+  }
+  return info.refinements;
+}
+
 TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionShowsIt) {
   // ActiveSetRefinement::reach: the refinements stop once their mean contraction would not
   // bring the residual to it within the cap, and only then. A small penalty makes the
@@ -928,15 +943,7 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
     // Every call starts from the ADMM's iterate again.
     compute::ActiveSetRefinement request{active, targets, {0}, rho, 30, kGoal, {}, false};
     request.reach = reach;
-    compute::ActiveSetRefinementInfo info;
-    Eigen::MatrixXd x, y;
-    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
-    residual = 0.0;
-    const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
-    for (Index i = 0; i < r.size(); ++i) {
-      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
-    }
-    return info.refinements;
+    return refineColumnZero(*solver, qp, request, residual);
   };
   double slowResidual = 0.0, givenUpResidual = 0.0, fastResidual = 0.0, fastWithReachResidual = 0.0;
   const int slow = refine(1.0, 0.0, slowResidual);
@@ -968,16 +975,8 @@ TEST_F(VulkanAdmm, AStalledRefinementNearItsGoalStopsAtTheRoundingFloorAndFarFro
   Eigen::MatrixXd targets;
   polishActiveSet(qp, admm, active, targets);
   const auto refine = [&](int cap, double goal, double& residual) {
-    compute::ActiveSetRefinement request{active, targets, {0}, 1e-3, cap, goal, {}, false};
-    compute::ActiveSetRefinementInfo info;
-    Eigen::MatrixXd x, y;
-    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
-    residual = 0.0;
-    const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
-    for (Index i = 0; i < r.size(); ++i) {
-      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
-    }
-    return info.refinements;
+    const compute::ActiveSetRefinement request{active, targets, {0}, 1e-3, cap, goal, {}, false};
+    return refineColumnZero(*solver, qp, request, residual);
   };
   double first = 0.0, near = 0.0, far = 0.0;
   ASSERT_EQ(refine(1, 0.0, first), 1);

@@ -71,7 +71,6 @@ class Multigrid {
   /// coarse levels from them (the plain one ignores them).
   void setRho(Sequence& sequence, double rho, const DeviceCsrMatrix& K, const Array<double>& inverses,
               Array<std::uint32_t>& failure);
-  bool smoothed() const { return smoothed_; }
 
   /// The cycle's level-0 operands: input r, output z, K and its block inverses. Descriptor
   /// sets are built once per binding; a recording refers to it. The levels' vectors are
