@@ -116,6 +116,46 @@ TEST_F(VulkanMultigrid, SmoothedCycleEqualsTheHostReferenceOnAGlobalStepMatrix) 
   }
 }
 
+TEST_F(VulkanMultigrid, SmoothedCycleOfAKWithPartialBlocksEqualsTheHostReference) {
+  // The products of the smoothed cycle run over whole 4x4 blocks; a K whose pattern leaves
+  // out entries of its blocks is copied onto its block-complete pattern first. This K: the
+  // global step's, its entries (4i, 4j + 1) between different faces removed, and the rows'
+  // diagonals raised by what they lost (still positive definite: K - E + |E|'s row sums).
+  const auto [K0, K1] = splitK(globalStepMatrices(16));
+  compute::SparseMatrix K = K0 + K1 * 1e3;
+  K.makeCompressed();
+  std::vector<Eigen::Triplet<double>> kept;
+  Eigen::VectorXd lost = Eigen::VectorXd::Zero(K.rows());
+  for (Index r = 0; r < K.rows(); ++r) {
+    for (compute::SparseMatrix::InnerIterator it(K, r); it; ++it) {
+      const Index c = it.col();
+      const bool removed = r / 4 != c / 4 && ((r % 4 == 0 && c % 4 == 1) || (r % 4 == 1 && c % 4 == 0));
+      if (removed) {
+        lost[r] += std::abs(it.value());
+      } else {
+        kept.emplace_back(r, c, it.value());
+      }
+    }
+  }
+  for (Index r = 0; r < K.rows(); ++r) kept.emplace_back(r, r, lost[r]);
+  compute::SparseMatrix partial(K.rows(), K.cols());
+  partial.setFromTriplets(kept.begin(), kept.end());
+  partial.makeCompressed();
+  ASSERT_LT(partial.nonZeros(), K.nonZeros());
+  const compute::SparseMatrix zero = partial * 0.0;
+  const compute::BlockAggregation aggregation(partial, {4});
+  ASSERT_GE(aggregation.levelCount(), 2);
+  const Eigen::MatrixXd r = randomColumns(K.rows(), 3, 12);
+  const Eigen::MatrixXd device = deviceCycle(context(), aggregation, partial, zero, 1.0, r, nullptr, true);
+  compute::BlockMultigridSettings smoothed{4};
+  smoothed.smoothProlongation = true;
+  const compute::BlockMultigrid host(aggregation, partial, smoothed);
+  for (Eigen::Index c = 0; c < r.cols(); ++c) {
+    const Eigen::VectorXd expected = host.apply(r.col(c));
+    EXPECT_LT((device.col(c) - expected).norm() / expected.norm(), 1e-9) << "column " << c;
+  }
+}
+
 TEST_F(VulkanMultigrid, OneLevelIsTheExactInverse) {
   const auto [K0, K1] = splitK(globalStepMatrices(4));  // 16 faces: below the coarsest size
   const compute::BlockAggregation aggregation(compute::SparseMatrix(K0 + K1), {4});

@@ -1,5 +1,6 @@
 #include "compute/vulkan/VulkanSmoothedTransfer.h"
 
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -15,11 +16,11 @@ struct ProlongationPush {  // mg_smoothed_prolongation
   std::uint32_t rows, b;
   double maxDamping, spectralBound;
 };
-struct ProductPush {  // la_product_transposed
-  std::uint32_t rows, entries;
+struct ProductPush {  // la_block_product_transposed
+  std::uint32_t blockCount, b;
 };
 
-/// A with sorted column indices, compressed (the merge of la_product_transposed
+/// A with sorted column indices, compressed (the merges of la_block_product_transposed
 /// and the lookups of storedEntryIndex need them sorted).
 compute::SparseMatrix sortedPattern(const compute::SparseMatrix& A) {
   const Eigen::SparseMatrix<double, Eigen::ColMajor, int> columnMajor = A;
@@ -52,6 +53,45 @@ compute::SparseMatrix prolongationPattern(const compute::SparseMatrix& fine, con
   return pattern;
 }
 
+/// A's pattern with every b x b block it touches stored whole (values 1).
+compute::SparseMatrix blockComplete(const compute::SparseMatrix& A, Index b) {
+  std::vector<Eigen::Triplet<double, int>> entries;
+  for (Index r = 0; r < A.rows(); ++r) {
+    for (compute::SparseMatrix::InnerIterator it(A, r); it; ++it) {
+      const Index I = r / b, J = it.col() / b;
+      for (Index q = 0; q < b; ++q) {
+        for (Index k = 0; k < b; ++k) {
+          entries.emplace_back(static_cast<int>(I * b + q), static_cast<int>(J * b + k), 1.0);
+        }
+      }
+    }
+  }
+  compute::SparseMatrix pattern(A.rows(), A.cols());
+  pattern.setFromTriplets(entries.begin(), entries.end(), [](double, double) { return 1.0; });
+  pattern.makeCompressed();
+  return pattern;
+}
+
+/// For every block of the block-complete C: its block row and the position of its first
+/// entry among C's stored entries (la_block_product_transposed's list of work).
+std::vector<std::int32_t> blockList(const compute::SparseMatrix& C, Index b) {
+  std::vector<std::int32_t> list;
+  for (Index I = 0; I < C.rows() / b; ++I) {
+    for (Index e = C.outerIndexPtr()[I * b]; e < C.outerIndexPtr()[I * b + 1]; e += b) {
+      list.push_back(static_cast<std::int32_t>(I));
+      list.push_back(static_cast<std::int32_t>(e));
+    }
+  }
+  return list;
+}
+
+std::unique_ptr<Array<std::int32_t>> uploadedList(Context& context, const std::vector<std::int32_t>& list) {
+  auto array = std::make_unique<Array<std::int32_t>>(context, std::max<std::size_t>(list.size(), 2), MemoryClass::Device,
+                                                     "multigrid product blocks");
+  if (!list.empty()) array->upload(list);
+  return array;
+}
+
 /// For each stored entry (r, c) of K, the entry (r, b aggregate[c / b] + c % b)
 /// of P's pattern it adds into: (K Z)'s values gathered onto that pattern.
 std::vector<std::int32_t> kzTargets(const compute::SparseMatrix& fine, const compute::SparseMatrix& pattern,
@@ -76,7 +116,7 @@ SmoothedTransfer::SmoothedTransfer(Context& context, LinearAlgebra& algebra, con
       block_(b),
       fineEntries_(elementCount(fine.nonZeros(), "a multigrid level's entries")),
       prolongation_(context, "mg_smoothed_prolongation", 8, sizeof(ProlongationPush)),
-      productTransposed_(context, "la_product_transposed", 9, sizeof(ProductPush)) {
+      productTransposed_(context, "la_block_product_transposed", 10, sizeof(ProductPush)) {
   if (fine.rows() != fine.cols() || fine.rows() % b != 0 || static_cast<Index>(aggregate.size()) * b != fine.rows()) {
     throwUsage("smoothed multigrid: a " + std::to_string(fine.rows()) + "-row level for " +
                std::to_string(aggregate.size()) + " aggregates of " + std::to_string(b) + " rows");
@@ -92,11 +132,27 @@ SmoothedTransfer::SmoothedTransfer(Context& context, LinearAlgebra& algebra, con
   }
   const compute::SparseMatrix P = prolongationPattern(finePattern, aggregate, coarseBlocks, b);
   const compute::SparseMatrix Pt = sortedPattern(compute::SparseMatrix(P.transpose()));
-  const compute::SparseMatrix W = sortedPattern(compute::SparseMatrix(Pt * finePattern));
+  // The products read K on its block-complete pattern: a copy of K's values there where
+  // K's own pattern is not (level 0's may leave out entries of a block; coarse ones never do).
+  const compute::SparseMatrix Kb = blockComplete(finePattern, b);
+  if (Kb.nonZeros() != finePattern.nonZeros()) {
+    Kb_ = std::make_unique<DeviceCsrMatrix>(context, Kb);
+    std::vector<std::int32_t> targets(static_cast<std::size_t>(finePattern.nonZeros()));
+    for (Index r = 0; r < finePattern.rows(); ++r) {
+      for (Index e = finePattern.outerIndexPtr()[r]; e < finePattern.outerIndexPtr()[r + 1]; ++e) {
+        targets[e] = compute::storedEntryIndex(Kb, r, finePattern.innerIndexPtr()[e]);
+      }
+    }
+    toKb_ = std::make_unique<DeviceGather>(context, targets, elementCount(Kb.nonZeros(), "a multigrid level's entries"),
+                                           "multigrid block-complete K");
+  }
+  const compute::SparseMatrix W = sortedPattern(compute::SparseMatrix(Pt * Kb));
   coarsePattern_ = compute::ones(sortedPattern(compute::SparseMatrix(W * P)));
   P_ = std::make_unique<DeviceCsrMatrix>(context, P);
   Pt_ = std::make_unique<DeviceCsrMatrix>(context, Pt);
   W_ = std::make_unique<DeviceCsrMatrix>(context, W);
+  wBlocks_ = uploadedList(context, blockList(W, b));
+  coarseBlocks_ = uploadedList(context, blockList(coarsePattern_, b));
   toKZ_ = std::make_unique<DeviceGather>(context, kzTargets(finePattern, P, aggregate, b),
                                          elementCount(P.nonZeros(), "a prolongation's entries"), "multigrid K Z");
   transpose_ =
@@ -149,17 +205,23 @@ void SmoothedTransfer::record(Sequence& sequence, const DeviceCsrMatrix& K, cons
                     groupsFor(context_, rows));
   sequence.barrier();
   algebra_.gatherSum(sequence, *transpose_, P_->values(), Pt_->values());
-  recordProduct(sequence, *Pt_, K, *W_);       // W = P^T K^T = P^T K
-  recordProduct(sequence, *Pt_, *W_, coarse);  // P^T W^T = P^T K P
+  const DeviceCsrMatrix* Kb = &K;
+  if (toKb_) {
+    algebra_.gatherSum(sequence, *toKb_, K.values(), Kb_->values());
+    Kb = Kb_.get();
+  }
+  recordProduct(sequence, *Pt_, *Kb, *W_, *wBlocks_);         // W = P^T K^T = P^T K
+  recordProduct(sequence, *Pt_, *W_, coarse, *coarseBlocks_);  // P^T W^T = P^T K P
 }
 
 void SmoothedTransfer::recordProduct(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceCsrMatrix& B,
-                                     DeviceCsrMatrix& C) {
-  const auto entries = static_cast<std::uint32_t>(C.values().count());
+                                     DeviceCsrMatrix& C, const Array<std::int32_t>& blocks) {
+  if (C.values().count() % (block_ * block_) != 0) throwUsage("smoothed multigrid: a product that is not block-complete");
+  const auto blockCount = static_cast<std::uint32_t>(C.values().count() / (block_ * block_));
   sequence.dispatch(productTransposed_,
                     {A.rowOffsets(), A.columns(), A.values(), B.rowOffsets(), B.columns(), B.values(), C.rowOffsets(),
-                     C.columns(), C.values()},
-                    ProductPush{C.rows(), entries}, groupsFor(context_, entries));
+                     C.columns(), C.values(), blocks},
+                    ProductPush{blockCount, block_}, groupsFor(context_, blockCount));
   sequence.barrier();
 }
 

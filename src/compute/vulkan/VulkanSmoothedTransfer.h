@@ -20,8 +20,9 @@
 //   KZ:      a gather of K's values onto P's pattern (each entry of K adds into one);
 //   P:       shaders/mg_smoothed_prolongation.comp, with the level's damped smoother
 //            (BlockMultigridSettings::smootherSpectralBound); P^T's values by a gather;
-//   P^T K P: W = P^T K, then P^T W^T, each shaders/la_product_transposed.comp (K is
-//            symmetric).
+//   P^T K P: W = P^T K, then P^T W^T, each shaders/la_block_product_transposed.comp over
+//            4x4 blocks (K is symmetric; all patterns block-complete, level 0's K copied
+//            onto its block-complete pattern where it is not).
 #include <memory>
 #include <vector>
 
@@ -57,7 +58,9 @@ class SmoothedTransfer {
   const Array<double>& smoother() const { return *smoother_; }
 
  private:
-  void recordProduct(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceCsrMatrix& B, DeviceCsrMatrix& C);
+  /// C = A B^T over C's `blocks` (blockList), all three block-complete.
+  void recordProduct(Sequence& sequence, const DeviceCsrMatrix& A, const DeviceCsrMatrix& B, DeviceCsrMatrix& C,
+                     const Array<std::int32_t>& blocks);
 
   Context& context_;
   LinearAlgebra& algebra_;
@@ -65,7 +68,9 @@ class SmoothedTransfer {
   std::uint32_t fineEntries_;
   compute::SparseMatrix coarsePattern_;
   std::unique_ptr<DeviceCsrMatrix> P_, Pt_, W_;
-  std::unique_ptr<DeviceGather> toKZ_, transpose_;
+  std::unique_ptr<DeviceCsrMatrix> Kb_;  ///< K on its block-complete pattern, where K's own is not.
+  std::unique_ptr<DeviceGather> toKZ_, transpose_, toKb_;
+  std::unique_ptr<Array<std::int32_t>> wBlocks_, coarseBlocks_;
   std::unique_ptr<Array<double>> kz_, smoother_;
   std::unique_ptr<Array<std::int32_t>> aggregates_;
   std::unique_ptr<DeviceVectors> start_, even_, odd_, product_;
