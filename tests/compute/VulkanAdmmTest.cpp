@@ -908,6 +908,16 @@ TEST_F(VulkanAdmm, ARefinementPastTheSolutionStopsItsSolveAtTheRoundingFloor) {
       << fourth.linearIterations << " PCG iterations in all";
 }
 
+/// A device solver that has solved `qp` (default settings, one workgroup), and the active
+/// set and targets of the polish of its solution: the start of the refinement tests.
+void solvedForRefinement(vk::Context& context, const BoxQp& qp, std::unique_ptr<compute::AdmmSolver>& solver,
+                         std::vector<char>& active, Eigen::MatrixXd& targets) {
+  solver = deviceSolver(context, qp, compute::AdmmSettings{}, kRecordings[1]);
+  const AdmmRun admm = runAdmm(*solver, qp);
+  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+  polishActiveSet(qp, admm, active, targets);
+}
+
 /// The refinements `request` (of column 0, from the solver's iterate) ran, and in
 /// `residual` the largest violation of its active rows after them.
 int refineColumnZero(compute::AdmmSolver& solver, const BoxQp& qp, const compute::ActiveSetRefinement& request,
@@ -931,13 +941,10 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
   // ADMM ends elsewhere), short of 1e-12, and a reach of 1e-12 gives up after 11. With
   // rho 1000 the refinements get to the goal with or without the reach.
   const BoxQp qp = randomBoxQp(30, 24, 17);
-  const compute::AdmmSettings settings;
-  auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
-  const AdmmRun admm = runAdmm(*solver, qp);
-  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+  std::unique_ptr<compute::AdmmSolver> solver;
   std::vector<char> active;
   Eigen::MatrixXd targets;
-  polishActiveSet(qp, admm, active, targets);
+  ASSERT_NO_FATAL_FAILURE(solvedForRefinement(context(), qp, solver, active, targets));
   constexpr double kGoal = 1e-12;
   const auto refine = [&](double rho, double reach, double& residual) {
     // Every call starts from the ADMM's iterate again.
@@ -967,13 +974,10 @@ TEST_F(VulkanAdmm, AStalledRefinementNearItsGoalStopsAtTheRoundingFloorAndFarFro
   // large step's polish), and goes on to its cap when it is further. A tiny penalty makes
   // the method of multipliers stall from the start.
   const BoxQp qp = randomBoxQp(30, 24, 17);
-  const compute::AdmmSettings settings;
-  auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
-  const AdmmRun admm = runAdmm(*solver, qp);
-  ASSERT_EQ(admm.info.status, compute::AdmmStatus::Solved);
+  std::unique_ptr<compute::AdmmSolver> solver;
   std::vector<char> active;
   Eigen::MatrixXd targets;
-  polishActiveSet(qp, admm, active, targets);
+  ASSERT_NO_FATAL_FAILURE(solvedForRefinement(context(), qp, solver, active, targets));
   const auto refine = [&](int cap, double goal, double& residual) {
     const compute::ActiveSetRefinement request{active, targets, {0}, 1e-3, cap, goal, {}, false};
     return refineColumnZero(*solver, qp, request, residual);
