@@ -75,11 +75,13 @@ struct GlobalStepSettings {
   /// stop at their first converged iteration (AdmmSettings::convergenceCheckSolveIterations):
   /// the ~256-face exact step of BM_GlobalStep/vulkan 30 -> 22 ADMM and 6 208 -> 4 944 PCG
   /// iterations; the CPU's iteration is unchanged.
-  /// The cycle's prolongations are smoothed (AdmmSettings::smoothedMultigrid): a device
-  /// deformation of a translational grid (lavapipe, 2026-12-07) took 10 115 -> 5 871 PCG
-  /// iterations and 22.3 -> 20.1 s on 16x16 faces (8 iterations), 13 554 -> 6 351 and 93.8 ->
-  /// 61.1 s on 32x32 (2 iterations), 22 546 -> 12 614 and 322 -> 286 s on 48x48, its meshes
-  /// within 3e-11 (32x32) and 8e-10 (48x48) of the CPU's as before.
+  /// The cycle's prolongations are smoothed (AdmmSettings::smoothedMultigrid), with the
+  /// inner solves' tolerance at 1e-3 of the ADMM's residuals (1e-2 let the smoothed solves
+  /// drift the ADMM's iteration): a device deformation of a translational grid (lavapipe,
+  /// 2026-12-07, README) took 10 115 -> 6 065 PCG iterations and 27.8 -> 23.5 s on 16x16
+  /// faces (8 iterations), 13 554 -> 6 106 and ~110 -> ~76 s on 32x32 (2 iterations),
+  /// 22 546 -> 13 052 and 322 -> 294 s on 48x48, its meshes within 2.9e-11 (32x32) and
+  /// 2.7e-9 (48x48) of the diagonal from the CPU's.
   /// An ε = 0 attempt solved by the ADMM (an iterative backend's) after one of the last step
   /// starts from that one's multipliers and rho (BoxQpSettings::warmStartEqualities); the
   /// CPU solves those attempts directly.
