@@ -6,12 +6,16 @@
 # Fortran runtimes, the Vulkan loader) and `run.sh`, which runs them from there.
 #
 #   bash scripts/bench-bundle.sh [DIR]          # default DIR: build/bench-bundle (~25 MiB)
-#   DIR/run.sh [FILTER] [plano_bench options]   # on the GPU machine
+#   DIR/run.sh [FILTER] [plano_bench options]   # on the GPU machine (FILTER '': the default runs)
 #
-# run.sh writes DIR/results/bench-<date>.json (Google Benchmark's JSON, with the Vulkan
-# device's name in its context) and prints the console table. FILTER defaults to the
-# kernel and whole-iteration benchmarks of README.md's tables, CPU and Vulkan, ~4k to 1M
-# faces. run.sh refuses to measure on a CPU device (lavapipe) unless
+# run.sh writes Google Benchmark's JSON (with the Vulkan device's name in its context) to
+# DIR/results/ and prints the console table. Without FILTER it measures the kernel and
+# whole-iteration benchmarks of README.md's tables, ~4k to 1M faces, in three runs, each
+# with its own JSON file, in the order that matters on a GPU whose time is short: the
+# Vulkan kernels (bench-<date>-kernels.json), the Vulkan whole iterations (-loops.json: the
+# global step and the deformation iteration up to 1M faces) and then their CPU
+# counterparts (-cpu.json); a run cut short keeps the files of the runs before it. With
+# FILTER, one run (bench-<date>.json). run.sh refuses to measure on a CPU device (lavapipe) unless
 # PLANO_BENCH_ALLOW_CPU_DEVICE=1: the bundle's purpose is the GPU's figures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -39,8 +43,10 @@ cat > "$out/run.sh" <<'RUN'
 # Runs the bundled benchmarks (see scripts/bench-bundle.sh in Plano's sources).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-filter=${1:-'FacePlanarity|ProjectiveFits|ClosestRotations|IdealMaps|Spmv|SpdSolve|MultigridCycle|BM_LocalStep|RigidLocalStep|BM_GlobalStep/|DeformationIteration|SubspaceDeformationIteration|PqSubdivisionLevel'}
+filter=${1:-}
 shift || true
+kernels='FacePlanarity|ProjectiveFits|ClosestRotations|IdealMaps|Spmv|SpdSolve|MultigridCycle|BM_LocalStep|RigidLocalStep'
+loops='BM_GlobalStep|DeformationIteration|PqSubdivisionLevel'  # also SubspaceDeformationIteration/<space>
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 # The Vulkan device the benchmarks will use, as `plano` names its backend.
 mkdir -p "$here/results"
@@ -59,10 +65,19 @@ if grep -q -i 'llvmpipe\|lavapipe' <<<"$device" && [[ "${PLANO_BENCH_ALLOW_CPU_D
   echo "run.sh: the Vulkan device is Mesa's CPU emulation, not a GPU; set PLANO_BENCH_ALLOW_CPU_DEVICE=1 to measure it anyway" >&2
   exit 2
 fi
-result="$here/results/bench-$stamp.json"
 echo "$device" > "$here/results/bench-$stamp.device.txt"
-"$here/bin/plano_bench" --benchmark_filter="$filter" --benchmark_out="$result" --benchmark_out_format=json "$@"
-echo "run.sh: results in $result (device: $device)"
+measure() {  # measure FILTER JSON [plano_bench options]
+  local result="$here/results/$2"
+  "$here/bin/plano_bench" --benchmark_filter="$1" --benchmark_out="$result" --benchmark_out_format=json "${@:3}"
+  echo "run.sh: results in $result (device: $device)"
+}
+if [[ -n "$filter" ]]; then
+  measure "$filter" "bench-$stamp.json" "$@"
+else
+  measure "($kernels)/vulkan" "bench-$stamp-kernels.json" "$@"
+  measure "($loops)(/[a-z]+)?/vulkan" "bench-$stamp-loops.json" "$@"
+  measure "($kernels|$loops)(/[a-z]+)?/cpu" "bench-$stamp-cpu.json" "$@"
+fi
 RUN
 chmod +x "$out/run.sh"
 echo "bench-bundle: $(du -sh "$out" | cut -f1) in $out; run $out/run.sh on the target machine"
