@@ -7,6 +7,7 @@
 
 #include "mesh/Generators.h"
 #include "mesh/MeshIO.h"
+#include "support/ScopedEnvironment.h"
 #include "support/TestMeshes.h"
 
 namespace plano {
@@ -38,6 +39,25 @@ TEST(CommandOptions, NonFiniteNumbersAreUsageErrorsOfEveryCommandAndWriteNothing
   // Finite values of the same options run.
   EXPECT_EQ(test::runTool("-q explore " + grid + " -o " + out + " --amplitude 0.02").exitCode, 0);
   EXPECT_TRUE(std::filesystem::exists(out));
+}
+
+TEST(CommandOptions, ANegativeThreadCountOrAMalformedPlanoThreadsIsAUsageErrorBeforeTheRun) {
+  const test::TempDir dir;
+  writeMesh(dir / "grid.obj", generate::hyparGrid(6, 0.5));
+  const std::string planarize = "-q planarize " + (dir / "grid.obj").string() + " -o " + (dir / "out.obj").string();
+  test::ToolResult result = test::runTool("--threads -1 " + planarize);
+  EXPECT_EQ(result.exitCode, 2) << result.err;
+  EXPECT_NE(result.err.find("--threads"), std::string::npos) << result.err;
+  {
+    const test::ScopedEnvironment threads("PLANO_THREADS", "many");
+    result = test::runTool(planarize);
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_NE(result.err.find("PLANO_THREADS is 'many'"), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.obj"));
+    // --threads decides, so the variable is not read.
+    EXPECT_EQ(test::runTool("--threads 2 " + planarize).exitCode, 0);
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "out.obj"));
 }
 
 TEST(CommandOptions, WrittenFilesOverInputsOrIntoMissingFoldersAreRefusedBeforeTheRun) {

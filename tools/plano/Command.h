@@ -17,6 +17,7 @@ namespace plano::cli {
 struct GlobalOptions {
   std::string backend = "cpu";  ///< cpu | vulkan | auto
   bool quiet = false;           ///< No progress on stderr.
+  int threads = 0;              ///< CPU threads of the per-face work (0: cpuThreads()'s default).
 };
 
 /// A command's run function: returns the exit code. Errors are thrown as plano::Error

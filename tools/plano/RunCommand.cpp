@@ -4,6 +4,7 @@
 
 #include "core/Cancellation.h"
 #include "core/Error.h"
+#include "core/ParallelFor.h"
 #include "plano/Report.h"
 
 namespace plano::cli {
@@ -33,6 +34,8 @@ int runCommand(const CommandRun& command, GlobalOptions options, std::ostream& e
   try {
     try {
       checkCommandPaths(command.paths);
+      setCpuThreads(options.threads);
+      cpuThreads();  // a malformed PLANO_THREADS is an error before any work, not in the middle of it
       return runOnce(command, options);
     } catch (const Error& e) {
       // With auto, a device error can only come from a Vulkan backend (the CPU one has no device).

@@ -168,6 +168,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
       ->capture_default_str();
   app.add_flag("-q,--quiet", options.quiet, "No progress messages on stderr");
+  app.add_option("--threads", options.threads,
+                 "CPU threads for the per-face work (0: the PLANO_THREADS environment variable, else every core)")
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
 
   auto& registry = commandRegistry();
   std::stable_sort(registry.begin(), registry.end(), [](const auto& a, const auto& b) { return a.order < b.order; });

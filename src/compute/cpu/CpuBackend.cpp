@@ -8,6 +8,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/Memory.h"
+#include "core/ParallelFor.h"
 #include "mesh/Planarity.h"
 #include "projective/IdealMapFit.h"
 #include "projective/LocalFit.h"
@@ -114,10 +115,19 @@ class CholmodSpdSolver final : public SpdSolver {
   SupernodalCholesky factor_;
 };
 
+/// Items per thread at the least (core/ParallelFor.h): on this machine's cores a thread's
+/// start costs about what a thousand faces' planarity or a hundred faces' fits do.
+constexpr std::ptrdiff_t kPlanaritiesPerThread = 16384;
+constexpr std::ptrdiff_t kFitsPerThread = 512;
+
 }  // namespace
 
 void CpuBackend::facePlanarity(const PolygonMesh& mesh, std::span<double> out) {
-  for (Index f = 0; f < mesh.faceCount(); ++f) out[f] = plano::facePlanarity(mesh.vertices, mesh.faces[f]).mean;
+  parallelFor(mesh.faceCount(), kPlanaritiesPerThread, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    for (auto f = static_cast<Index>(begin); f < end; ++f) {
+      out[f] = plano::facePlanarity(mesh.vertices, mesh.faces[f]).mean;
+    }
+  });
 }
 
 void CpuBackend::fitProjectiveMaps(const FaceList& faces, const Positions& source, const Positions& target,
@@ -128,36 +138,46 @@ void CpuBackend::fitProjectiveMaps(const FaceList& faces, const Positions& sourc
   out.reciprocalScales.resize(faces.cornerCount());
   out.residuals.resize(faceCount);
   out.ranks.resize(faceCount);
-  std::vector<Eigen::Vector3d> p;
-  std::vector<Eigen::Vector3d> q;
-  for (Index f = 0; f < faceCount; ++f) {
-    const auto face = faces[f];
-    p.clear();
-    q.clear();
-    for (Index v : face) {
-      p.emplace_back(source.row(v).transpose());
-      q.emplace_back(target.row(v).transpose());
+  parallelFor(faceCount, kFitsPerThread, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    std::vector<Eigen::Vector3d> p;
+    std::vector<Eigen::Vector3d> q;
+    for (auto f = static_cast<Index>(begin); f < end; ++f) {
+      const auto face = faces[f];
+      p.clear();
+      q.clear();
+      for (Index v : face) {
+        p.emplace_back(source.row(v).transpose());
+        q.emplace_back(target.row(v).transpose());
+      }
+      const projective::ProjectiveFit fit = projective::fitProjectiveMap(p, q);
+      out.maps[f] = fit.map;
+      out.residuals[f] = fit.residual;
+      out.ranks[f] = fit.rank;
+      std::copy(fit.reciprocalScales.begin(), fit.reciprocalScales.end(),
+                out.reciprocalScales.begin() + faces.offsets()[f]);
     }
-    const projective::ProjectiveFit fit = projective::fitProjectiveMap(p, q);
-    out.maps[f] = fit.map;
-    out.residuals[f] = fit.residual;
-    out.ranks[f] = fit.rank;
-    std::copy(fit.reciprocalScales.begin(), fit.reciprocalScales.end(),
-              out.reciprocalScales.begin() + faces.offsets()[f]);
-  }
+  });
 }
 
 void CpuBackend::closestRotations(std::span<const Eigen::Matrix3d> matrices, std::span<Eigen::Matrix3d> rotations,
                                   std::span<Eigen::Vector3d> singularValues) {
-  for (std::size_t i = 0; i < matrices.size(); ++i) {
-    Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrices[i], Eigen::ComputeFullU | Eigen::ComputeFullV);
-    const Eigen::Matrix3d& U = svd.matrixU();
-    const Eigen::Matrix3d& V = svd.matrixV();
-    const double d = (U * V.transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-    rotations[i] = U * Eigen::Vector3d(1.0, 1.0, d).asDiagonal() * V.transpose();
-    singularValues[i] = svd.singularValues();
-    singularValues[i][2] *= d;
-  }
+  parallelFor(static_cast<std::ptrdiff_t>(matrices.size()), kFitsPerThread,
+              [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+                for (auto i = static_cast<std::size_t>(begin); i < static_cast<std::size_t>(end); ++i) {
+                  closestRotation(matrices[i], rotations[i], singularValues[i]);
+                }
+              });
+}
+
+void CpuBackend::closestRotation(const Eigen::Matrix3d& matrix, Eigen::Matrix3d& rotation,
+                                 Eigen::Vector3d& singularValues) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d& U = svd.matrixU();
+  const Eigen::Matrix3d& V = svd.matrixV();
+  const double d = (U * V.transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  rotation = U * Eigen::Vector3d(1.0, 1.0, d).asDiagonal() * V.transpose();
+  singularValues = svd.singularValues();
+  singularValues[2] *= d;
 }
 
 void CpuBackend::closestIdealMaps(const FaceList& faces, const Positions& source,
@@ -167,24 +187,27 @@ void CpuBackend::closestIdealMaps(const FaceList& faces, const Positions& source
   const Index faceCount = faces.size();
   out.maps.resize(faceCount);
   out.methods.resize(faceCount);
-  Eigen::Matrix<double, Eigen::Dynamic, 3> p, q;
-  for (Index f = 0; f < faceCount; ++f) {
-    const auto face = faces[f];
-    const auto k = static_cast<Eigen::Index>(face.size());
-    p.resize(k, 3);
-    q.resize(k, 3);
-    for (Eigen::Index i = 0; i < k; ++i) {
-      p.row(i) = source.row(face[i]);
-      if (target) q.row(i) = target->row(face[i]);
+  parallelFor(faceCount, kFitsPerThread, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    Eigen::Matrix<double, Eigen::Dynamic, 3> p, q;
+    for (auto f = static_cast<Index>(begin); f < end; ++f) {
+      const auto face = faces[f];
+      const auto k = static_cast<Eigen::Index>(face.size());
+      p.resize(k, 3);
+      q.resize(k, 3);
+      for (Eigen::Index i = 0; i < k; ++i) {
+        p.row(i) = source.row(face[i]);
+        if (target) q.row(i) = target->row(face[i]);
+      }
+      const projective::IdealMapLinearization lin = projective::linearizeFaceMap(p, fitted[f], target ? &q : nullptr);
+      Eigen::Matrix3d R;
+      Eigen::Vector3d singular;
+      closestRotation(lin.linear, R, singular);
+      out.methods[f] = lin.method;
+      out.maps[f] = lin.method == IdealMapMethod::CentroidAtInfinity
+                        ? Eigen::Matrix4d::Identity()
+                        : projective::idealMapOf(lin, R, singular, similar);
     }
-    const projective::IdealMapLinearization lin = projective::linearizeFaceMap(p, fitted[f], target ? &q : nullptr);
-    Eigen::Matrix3d R;
-    Eigen::Vector3d singular;
-    closestRotations({&lin.linear, 1}, {&R, 1}, {&singular, 1});
-    out.methods[f] = lin.method;
-    out.maps[f] = lin.method == IdealMapMethod::CentroidAtInfinity ? Eigen::Matrix4d::Identity()
-                                                                    : projective::idealMapOf(lin, R, singular, similar);
-  }
+  });
 }
 
 std::unique_ptr<SpdSolver> CpuBackend::createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) {

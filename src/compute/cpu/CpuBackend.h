@@ -1,6 +1,8 @@
 #pragma once
-// The CPU reference backend: Eigen, one face at a time, a prefactored sparse Cholesky
-// (CHOLMOD) for the SPD solves. Every Vulkan kernel is checked against it.
+// The CPU reference backend: Eigen, one face at a time (the batched per-face kernels split
+// the faces over core/ParallelFor.h's threads, cpuThreads(); every face's result is the same
+// whatever their count), a prefactored sparse Cholesky (CHOLMOD) for the SPD solves. Every
+// Vulkan kernel is checked against it.
 #include "compute/Backend.h"
 
 namespace plano::compute {
@@ -19,6 +21,10 @@ class CpuBackend final : public Backend {
                         const Positions* target, bool similar, IdealMaps& out) override;
   std::unique_ptr<SpdSolver> createSpdSolver(const SparseMatrix& A, const LinearSolverSettings& settings) override;
   bool factorsSpdMatrices() const override { return true; }  ///< CHOLMOD
+
+ private:
+  /// One matrix's closest rotation (closestRotations' work per item).
+  static void closestRotation(const Eigen::Matrix3d& matrix, Eigen::Matrix3d& rotation, Eigen::Vector3d& singularValues);
 };
 
 }  // namespace plano::compute

@@ -1,0 +1,29 @@
+#pragma once
+// Parallel loops over independent items (the CPU backend's batched per-face kernels), on
+// plain std::threads as libigl's parallel_for: no OpenMP runtime to match between the
+// compilers that build Plano (GCC, and clang for the sanitizer build).
+//
+// Each item's result depends on that item alone, so the results are the same bit for bit
+// whatever the thread count; the threads only divide the items.
+#include <cstddef>
+#include <functional>
+
+namespace plano {
+
+/// Threads the CPU's batched work uses: the count setCpuThreads gave, else the environment
+/// variable PLANO_THREADS (a positive integer), else every hardware thread. Throws
+/// Error(Usage) when PLANO_THREADS is set to anything else.
+int cpuThreads();
+/// Use `threads` threads from now on (1: the calling thread alone); 0 returns to the
+/// default above. Throws Error(Usage) for a negative count.
+void setCpuThreads(int threads);
+
+/// body(begin, end) over [0, count) in contiguous chunks, one per thread, each of at least
+/// `minimumChunk` items (fewer threads for less work: starting a thread costs about as
+/// much as a few hundred faces' fits); the calling thread runs the first chunk. Returns
+/// once every chunk is done; an exception thrown by a chunk is rethrown then (the lowest
+/// chunk's when several throw).
+void parallelFor(std::ptrdiff_t count, std::ptrdiff_t minimumChunk,
+                 const std::function<void(std::ptrdiff_t begin, std::ptrdiff_t end)>& body);
+
+}  // namespace plano

@@ -1,0 +1,101 @@
+#include "core/ParallelFor.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "core/Error.h"
+#include "support/ScopedEnvironment.h"
+
+namespace plano {
+namespace {
+
+/// Returns to the default thread count after each test: the suite may run in one process.
+class ParallelFor : public ::testing::Test {
+ protected:
+  void TearDown() override { setCpuThreads(0); }
+};
+
+TEST_F(ParallelFor, EveryItemIsVisitedOnceInContiguousChunksWhateverTheThreadCount) {
+  for (int threads : {1, 2, 3, 8}) {
+    SCOPED_TRACE(threads);
+    setCpuThreads(threads);
+    std::vector<int> visits(10007, 0);
+    std::mutex mutex;
+    std::vector<std::pair<std::ptrdiff_t, std::ptrdiff_t>> chunks;
+    parallelFor(static_cast<std::ptrdiff_t>(visits.size()), 1, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (std::ptrdiff_t i = begin; i < end; ++i) ++visits[static_cast<std::size_t>(i)];
+      const std::lock_guard<std::mutex> lock(mutex);
+      chunks.emplace_back(begin, end);
+    });
+    EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), static_cast<std::ptrdiff_t>(visits.size()));
+    EXPECT_EQ(chunks.size(), static_cast<std::size_t>(threads));
+  }
+}
+
+TEST_F(ParallelFor, LessWorkThanTwoMinimumChunksRunsOnTheCallingThreadAlone) {
+  setCpuThreads(8);
+  std::vector<std::thread::id> runners;
+  parallelFor(1000, 512, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    EXPECT_EQ(begin, 0);
+    EXPECT_EQ(end, 1000);
+    runners.push_back(std::this_thread::get_id());
+  });
+  ASSERT_EQ(runners.size(), 1u);
+  EXPECT_EQ(runners.front(), std::this_thread::get_id());
+  int calls = 0;
+  parallelFor(0, 1, [&](std::ptrdiff_t, std::ptrdiff_t) { ++calls; });
+  EXPECT_EQ(calls, 0) << "no items, no call";
+}
+
+TEST_F(ParallelFor, AChunksExceptionIsRethrownOnceEveryChunkHasFinished) {
+  setCpuThreads(4);
+  std::vector<int> visits(4000, 0);
+  try {
+    parallelFor(4000, 1, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (std::ptrdiff_t i = begin; i < end; ++i) ++visits[static_cast<std::size_t>(i)];
+      if (begin > 0) throw std::runtime_error("chunk from " + std::to_string(begin));
+    });
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "chunk from 1000") << "the lowest chunk's";
+  }
+  EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), 4000) << "the other chunks ran to their end";
+}
+
+TEST_F(ParallelFor, TheThreadCountIsTheChosenOneElsePlanoThreadsElseEveryCore) {
+  if (std::getenv("PLANO_THREADS") == nullptr) {
+    EXPECT_EQ(cpuThreads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  }
+  const test::ScopedEnvironment environment("PLANO_THREADS", "3");
+  EXPECT_EQ(cpuThreads(), 3);
+  setCpuThreads(2);
+  EXPECT_EQ(cpuThreads(), 2);
+  setCpuThreads(0);
+  EXPECT_EQ(cpuThreads(), 3);
+}
+
+TEST_F(ParallelFor, AMalformedPlanoThreadsOrANegativeCountIsAUsageErrorThatNamesIt) {
+  for (const char* value : {"abc", "0", "-2", "4x", "100000"}) {
+    SCOPED_TRACE(value);
+    const test::ScopedEnvironment environment("PLANO_THREADS", value);
+    try {
+      cpuThreads();
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage);
+      EXPECT_NE(std::string(e.what()).find("PLANO_THREADS"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(setCpuThreads(-1), Error);
+}
+
+}  // namespace
+}  // namespace plano
