@@ -14,6 +14,7 @@
 
 #include "compute/Backend.h"
 #include "compute/vulkan/VulkanSequence.h"
+#include "core/ParallelFor.h"
 #include "mesh/Generators.h"
 
 namespace plano::bench {
@@ -59,11 +60,13 @@ inline compute::Backend* sharedBackend(compute::BackendChoice choice, std::strin
   return slot.backend.get();
 }
 
-/// Backend for a benchmark, or SkipWithError (e.g. no Vulkan device) and null.
+/// Backend for a benchmark, or SkipWithError (e.g. no Vulkan device) and null. A CPU
+/// benchmark reports the threads of its per-face kernels (cpu_threads: core/ParallelFor.h).
 inline compute::Backend* backendOrSkip(benchmark::State& state, compute::BackendChoice choice) {
   std::string error;
   compute::Backend* backend = sharedBackend(choice, &error);
   if (!backend) state.SkipWithError(("no backend: " + error).c_str());
+  if (backend && backend->kind() == compute::BackendKind::Cpu) state.counters["cpu_threads"] = cpuThreads();
   return backend;
 }
 
