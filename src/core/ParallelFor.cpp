@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -14,13 +15,15 @@ namespace plano {
 namespace {
 
 std::atomic<int> chosenThreads{0};  // 0: the default
+constexpr int kMaxThreads = 4096;
 
 int defaultThreads() {
   if (const char* text = std::getenv("PLANO_THREADS"); text != nullptr && *text != '\0') {
     char* end = nullptr;
     const long value = std::strtol(text, &end, 10);
-    if (*end != '\0' || value < 1 || value > 4096) {
-      throwUsage("PLANO_THREADS is '" + std::string(text) + "' (need a thread count from 1 to 4096)");
+    if (*end != '\0' || value < 1 || value > kMaxThreads) {
+      throwUsage("PLANO_THREADS is '" + std::string(text) + "' (need a thread count from 1 to " +
+                 std::to_string(kMaxThreads) + ")");
     }
     return static_cast<int>(value);
   }
@@ -35,7 +38,10 @@ int cpuThreads() {
 }
 
 void setCpuThreads(int threads) {
-  if (threads < 0) throwUsage("a CPU thread count of " + std::to_string(threads) + " (need 0 for the default, or more)");
+  if (threads < 0 || threads > kMaxThreads) {
+    throwUsage("a CPU thread count of " + std::to_string(threads) + " (need 1 to " + std::to_string(kMaxThreads) +
+               ", or 0 for the default)");
+  }
   chosenThreads.store(threads, std::memory_order_relaxed);
 }
 

@@ -15,7 +15,7 @@ namespace plano {
 /// Error(Usage) when PLANO_THREADS is set to anything else.
 int cpuThreads();
 /// Use `threads` threads from now on (1: the calling thread alone); 0 returns to the
-/// default above. Throws Error(Usage) for a negative count. A program that runs several
+/// default above. Throws Error(Usage) for a count below 0 or above 4096. A program that runs several
 /// meshes at once on threads of its own sets 1 (or its cores over its threads): each
 /// kernel call otherwise starts cpuThreads() threads of its own.
 void setCpuThreads(int threads);

@@ -95,6 +95,7 @@ TEST_F(ParallelFor, AMalformedPlanoThreadsOrANegativeCountIsAUsageErrorThatNames
     }
   }
   EXPECT_THROW(setCpuThreads(-1), Error);
+  EXPECT_THROW(setCpuThreads(5000), Error);
 }
 
 }  // namespace
