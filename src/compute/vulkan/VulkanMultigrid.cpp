@@ -56,14 +56,10 @@ std::span<const double> valuesOf(const compute::SparseMatrix& A) {
 /// aggregation's prolongation (row b i + k -> b a_i + k, columns alike).
 std::vector<std::int32_t> coarseEntries(const compute::SparseMatrix& fine, const compute::SparseMatrix& coarse,
                                         const std::vector<Index>& aggregate, Index b) {
-  std::vector<std::int32_t> targets(static_cast<std::size_t>(fine.nonZeros()));
-  for (Index row = 0; row < fine.rows(); ++row) {
-    const Index coarseRow = b * aggregate[row / b] + row % b;
-    for (Index e = fine.outerIndexPtr()[row]; e < fine.outerIndexPtr()[row + 1]; ++e) {
-      const Index column = fine.innerIndexPtr()[e];
-      targets[e] = compute::storedEntryIndex(coarse, coarseRow, b * aggregate[column / b] + column % b);
-      if (targets[e] < 0) throwDevice("Vulkan multigrid: a fine entry has no coarse entry");
-    }
+  const auto coarseIndex = [&](Index i) { return b * aggregate[i / b] + i % b; };
+  std::vector<std::int32_t> targets = compute::entryTargets(fine, coarse, coarseIndex, coarseIndex);
+  if (std::find(targets.begin(), targets.end(), -1) != targets.end()) {
+    throwDevice("Vulkan multigrid: a fine entry has no coarse entry");
   }
   return targets;
 }

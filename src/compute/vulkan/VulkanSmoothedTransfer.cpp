@@ -96,13 +96,10 @@ std::unique_ptr<Array<std::int32_t>> uploadedList(Context& context, const std::v
 /// of P's pattern it adds into: (K Z)'s values gathered onto that pattern.
 std::vector<std::int32_t> kzTargets(const compute::SparseMatrix& fine, const compute::SparseMatrix& pattern,
                                     const std::vector<Index>& aggregate, Index b) {
-  std::vector<std::int32_t> targets(static_cast<std::size_t>(fine.nonZeros()));
-  for (Index r = 0; r < fine.rows(); ++r) {
-    for (Index e = fine.outerIndexPtr()[r]; e < fine.outerIndexPtr()[r + 1]; ++e) {
-      const Index c = fine.innerIndexPtr()[e];
-      targets[e] = compute::storedEntryIndex(pattern, r, b * aggregate[c / b] + c % b);
-      if (targets[e] < 0) throwDevice("Vulkan smoothed multigrid: an entry of K Z outside P's pattern");
-    }
+  std::vector<std::int32_t> targets = compute::entryTargets(
+      fine, pattern, [](Index r) { return r; }, [&](Index c) { return b * aggregate[c / b] + c % b; });
+  if (std::find(targets.begin(), targets.end(), -1) != targets.end()) {
+    throwDevice("Vulkan smoothed multigrid: an entry of K Z outside P's pattern");
   }
   return targets;
 }
@@ -137,13 +134,9 @@ SmoothedTransfer::SmoothedTransfer(Context& context, LinearAlgebra& algebra, con
   const compute::SparseMatrix Kb = blockComplete(finePattern, b);
   if (Kb.nonZeros() != finePattern.nonZeros()) {
     Kb_ = std::make_unique<DeviceCsrMatrix>(context, Kb);
-    std::vector<std::int32_t> targets(static_cast<std::size_t>(finePattern.nonZeros()));
-    for (Index r = 0; r < finePattern.rows(); ++r) {
-      for (Index e = finePattern.outerIndexPtr()[r]; e < finePattern.outerIndexPtr()[r + 1]; ++e) {
-        targets[e] = compute::storedEntryIndex(Kb, r, finePattern.innerIndexPtr()[e]);
-      }
-    }
-    toKb_ = std::make_unique<DeviceGather>(context, targets, elementCount(Kb.nonZeros(), "a multigrid level's entries"),
+    const auto same = [](Index i) { return i; };
+    toKb_ = std::make_unique<DeviceGather>(context, compute::entryTargets(finePattern, Kb, same, same),
+                                           elementCount(Kb.nonZeros(), "a multigrid level's entries"),
                                            "multigrid block-complete K");
   }
   const compute::SparseMatrix W = sortedPattern(compute::SparseMatrix(Pt * Kb));
