@@ -1,6 +1,7 @@
 // The CPU backend's prefactored Cholesky (CHOLMOD).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -51,6 +52,40 @@ TEST(CpuSpdSolver, WithoutTheResidualItGivesTheSameSolutionAndStillFlagsNonFinit
   bad(3, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(unmeasured->solve(bad, Y).converged);
   EXPECT_FALSE(measured->solve(bad, X).converged);
+}
+
+/// A dense SPD matrix stored sparse: CHOLMOD factors it supernodally (about 2n/3 flops per
+/// entry of L), where the mesh matrices of meshSystem() get a simplicial factor.
+compute::SparseMatrix denseSpd(Eigen::Index n) {
+  const Eigen::MatrixXd M = Eigen::MatrixXd::Random(n, n);
+  const Eigen::MatrixXd A = M * M.transpose() + static_cast<double>(n) * Eigen::MatrixXd::Identity(n, n);
+  return A.sparseView();
+}
+
+TEST(CpuSpdSolver, SolvesToRoundingAndRefusesIndefiniteMatricesWithSimplicialAndSupernodalFactors) {
+  compute::CpuBackend cpu;
+  const System mesh = meshSystem();
+  const compute::SparseMatrix dense = denseSpd(400);
+  for (const compute::SparseMatrix* A : {&mesh.A, &dense}) {
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(A->rows(), 3);
+    auto solver = cpu.createSpdSolver(*A, {});
+    Eigen::MatrixXd X;
+    const compute::LinearSolveInfo info = solver->solve(B, X);
+    EXPECT_TRUE(info.converged);
+    EXPECT_LT(info.relativeResidual, 1e-12) << A->rows() << " rows";
+    EXPECT_LT((Eigen::MatrixXd(*A) * X - B).norm(), 1e-12 * B.norm()) << A->rows() << " rows";
+
+    // One pivot far below zero: no Cholesky factor exists, whichever kind was chosen.
+    compute::SparseMatrix indefinite = *A;
+    indefinite.coeffRef(A->rows() / 2, A->rows() / 2) = -1e3 * std::abs(A->coeff(0, 0));
+    EXPECT_THROW(cpu.createSpdSolver(indefinite, {}), Error) << A->rows() << " rows";
+    try {
+      solver->refactor(indefinite);
+      ADD_FAILURE() << "refactored an indefinite matrix, " << A->rows() << " rows";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Numerical);
+    }
+  }
 }
 
 TEST(CpuSpdSolver, AFactorLargerThanItsMemoryLimitIsRefusedNamingItsMatrixBeforeItIsComputed) {

@@ -16,19 +16,41 @@
 namespace plano::compute {
 namespace {
 
-/// CHOLMOD's supernodal Cholesky, with the memory its numeric factorization takes known
-/// from the symbolic analysis, before that memory is allocated.
-class SupernodalCholesky final : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> {
+/// CHOLMOD's Cholesky LL^T, simplicial or supernodal as CHOLMOD's analysis decides from the
+/// flops per factor entry (kSupernodalSwitch), with the memory its numeric factorization
+/// takes known from the symbolic analysis, before that memory is allocated.
+///
+/// Why not always supernodal: a supernodal factor's solves run a BLAS call per supernode,
+/// and the global steps' matrices of small and mid-sized meshes have many small ones, so
+/// its solves (thousands per factorization in the ADMM) took up to 2.5 times a simplicial
+/// factor's, while factoring no faster. Measured on a 2-core machine (fl = CHOLMOD's flop
+/// count; supernodal vs simplicial, ms): Enneper's first Catmull-Clark level, 21 600 rows,
+/// fl/lnz 28-69: solves 1.8-2.5 vs 0.70-1.23, factorizations 21-33 vs 7-24; the cube's
+/// 6 144-row level, fl/lnz 111-130: solves 0.64-0.76 vs 0.46-0.51, factorizations 15-18
+/// vs 14-17; the 16k-row global step, fl/lnz 177: about equal solves (3.0-3.5), factorizations
+/// 84-90 vs 117-120; the 262k-row one, fl/lnz 509: solves 115 vs 139, factorizations 2.1 vs
+/// 12.5 s. CHOLMOD's own switch (40) chose supernodal for some of the Enneper matrices.
+class CholeskyFactor final : public Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> {
  public:
+  /// Supernodal from this many flops per entry of L on (CHOLMOD's supernodal_switch).
+  static constexpr double kSupernodalSwitch = 150.0;
+
+  CholeskyFactor() {
+    // LL^T either way (a simplicial factor converted from CHOLMOD's LDL^T), so that a
+    // matrix that is not positive definite fails to factor whichever is chosen.
+    setMode(Eigen::CholmodSimplicialLLt);
+    cholmod().supernodal = CHOLMOD_AUTO;
+    cholmod().supernodal_switch = kSupernodalSwitch;
+  }
   /// analyzePattern gave a symbolic factor (CHOLMOD returns none when it fails, e.g. out of
   /// memory, and factorize would then read a null pointer).
   bool analyzed() const { return m_cholmodFactor != nullptr; }
   /// Bytes the numeric factorization holds at its peak, after analyzePattern (0 before):
   /// L's values and row indices, its largest update matrix, and the permuted copy of A's
-  /// lower triangle (a value and an index per entry) it factors. A simplicial factor, which
-  /// CHOLMOD does not choose here, holds an index beside each of its lnz values.
-  /// Measured (growth of VmHWM) on global-step matrices of 16k, 262k and 1M rows: 0.011 /
-  /// 0.387 / 1.99 GiB, against 0.018 / 0.42 / 1.90 GiB estimated here.
+  /// lower triangle (a value and an index per entry) it factors. A simplicial factor holds
+  /// an index beside each of its lnz values.
+  /// Measured (growth of VmHWM) on global-step matrices of 16k, 262k and 1M rows
+  /// (supernodal): 0.011 / 0.387 / 1.99 GiB, against 0.018 / 0.42 / 1.90 GiB estimated here.
   double numericBytes(Eigen::Index lowerNonZeros) {
     const cholmod_factor* L = m_cholmodFactor;
     if (!L) return 0.0;  // no analysis, or a failed one
@@ -40,7 +62,7 @@ class SupernodalCholesky final : public Eigen::CholmodSupernodalLLT<Eigen::Spars
   }
 };
 
-/// Prefactored sparse Cholesky (supernodal CHOLMOD). Solves are exact up to rounding.
+/// Prefactored sparse Cholesky (CHOLMOD, CholeskyFactor). Solves are exact up to rounding.
 class CholmodSpdSolver final : public SpdSolver {
  public:
   CholmodSpdSolver(const SparseMatrix& A, bool measureResidual, std::uint64_t memoryLimit)
@@ -112,7 +134,7 @@ class CholmodSpdSolver final : public SpdSolver {
   bool measureResidual_;
   double factorBytes_ = 0.0;
   Eigen::SparseMatrix<double> columnMajor_;
-  SupernodalCholesky factor_;
+  CholeskyFactor factor_;
 };
 
 /// Items per thread at the least (core/ParallelFor.h): a thread's start (tens of
