@@ -11,7 +11,8 @@
 //  - AdmmKernels (per backend): the vector work. start() loads the problem, iterate()
 //    runs a block of plain ADMM iterations, measure() returns the inf-norms, setRho()
 //    changes K = P + sigma I + C^T diag(rho) C. The host kernels (HostAdmmKernels) run the
-//    Eigen loop with a Backend SPD solver; the Vulkan kernels record the same steps as
+//    loop on the host (Eigen, and passes over C's rows on the CPU threads) with a Backend
+//    SPD solver; the Vulkan kernels record the same steps as
 //    compute shaders, so between two checks nothing but the block's submit crosses the bus.
 #include <Eigen/Core>
 #include <cstdint>
@@ -500,7 +501,7 @@ class AdmmSolver {
 /// Whether A and B are compressed and have the same size and the same nonzero positions.
 bool sameSparsityPattern(const SparseMatrix& A, const SparseMatrix& B);
 
-/// The host kernels: the Eigen loop, solving with `backend.createSpdSolver` (a prefactored
+/// The host kernels: the loop on the host, solving with `backend.createSpdSolver` (a prefactored
 /// Cholesky on the CPU backend). The default of Backend::createAdmmSolver.
 std::unique_ptr<AdmmKernels> createHostAdmmKernels(Backend& backend, const SparseMatrix& P, const SparseMatrix& C,
                                                    const AdmmSettings& settings);
