@@ -42,9 +42,41 @@ class CholeskyFactor final : public Eigen::CholmodDecomposition<Eigen::SparseMat
     cholmod().supernodal = CHOLMOD_AUTO;
     cholmod().supernodal_switch = kSupernodalSwitch;
   }
+  CholeskyFactor(const CholeskyFactor&) = delete;
+  CholeskyFactor& operator=(const CholeskyFactor&) = delete;
+  ~CholeskyFactor() {
+    cholmod_free_dense(&solution_, &cholmod());
+    cholmod_free_dense(&workY_, &cholmod());
+    cholmod_free_dense(&workE_, &cholmod());
+  }
+
   /// analyzePattern gave a symbolic factor (CHOLMOD returns none when it fails, e.g. out of
   /// memory, and factorize would then read a null pointer).
   bool analyzed() const { return m_cholmodFactor != nullptr; }
+
+  /// X = A^-1 B with the factor; false when CHOLMOD fails. Unlike Eigen's solve (cholmod_solve),
+  /// the solution and CHOLMOD's workspaces are kept for the next solve of the same shape:
+  /// the ADMM solves thousands of times with one factor, and each solve allocated (and,
+  /// at these sizes, mapped and zeroed) three n x k arrays.
+  bool solveInto(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+    if (!m_cholmodFactor || !m_factorizationIsOk) return false;
+    cholmod_dense b{};
+    b.nrow = static_cast<std::size_t>(B.rows());
+    b.ncol = static_cast<std::size_t>(B.cols());
+    b.nzmax = b.nrow * b.ncol;
+    b.d = b.nrow;
+    // CHOLMOD reads B only; its struct has no const view.
+    b.x = const_cast<double*>(B.data());
+    b.z = nullptr;
+    b.xtype = CHOLMOD_REAL;
+    b.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &b, nullptr, &solution_, nullptr, &workY_, &workE_,
+                        &cholmod())) {
+      return false;
+    }
+    X = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(solution_->x), B.rows(), B.cols());
+    return true;
+  }
   /// Bytes the numeric factorization holds at its peak, after analyzePattern (0 before):
   /// L's values and row indices, its largest update matrix, and the permuted copy of A's
   /// lower triangle (a value and an index per entry) it factors. A simplicial factor holds
@@ -60,6 +92,11 @@ class CholeskyFactor final : public Eigen::CholmodDecomposition<Eigen::SparseMat
     return sizeof(double) * (static_cast<double>(L->xsize) + static_cast<double>(L->maxcsize)) +
            sizeof(int) * static_cast<double>(L->ssize) + copy;
   }
+
+ private:
+  cholmod_dense* solution_ = nullptr;  ///< solveInto's X and workspaces, kept between solves.
+  cholmod_dense* workY_ = nullptr;
+  cholmod_dense* workE_ = nullptr;
 };
 
 /// Prefactored sparse Cholesky (CHOLMOD, CholeskyFactor). Solves are exact up to rounding.
@@ -92,12 +129,12 @@ class CholmodSpdSolver final : public SpdSolver {
     // Every ADMM iteration (BoxQp) and most solver iterations make a solve here: polling
     // here makes them interruptible without touching each loop.
     throwIfCancelled("a linear solve");
-    X = factor_.solve(B);
+    const bool solved = factor_.solveInto(B, X);
     LinearSolveInfo info;
     info.iterations = 1;
     // A non-finite B gives a non-finite X, whose residual relative to a NaN ||B|| would
     // read 0: finiteness is checked on X itself.
-    info.converged = factor_.info() == Eigen::Success && X.allFinite();
+    info.converged = solved && X.allFinite();
     if (measureResidual_) {
       const double bNorm = B.norm();
       info.relativeResidual = bNorm > 0.0 ? (columnMajor_ * X - B).norm() / bNorm : 0.0;
