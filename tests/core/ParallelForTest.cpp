@@ -70,6 +70,41 @@ TEST_F(ParallelFor, AChunksExceptionIsRethrownOnceEveryChunkHasFinished) {
   EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), 4000) << "the other chunks ran to their end";
 }
 
+TEST_F(ParallelFor, NestedConcurrentAndRepeatedCallsEachVisitEveryItemOnce) {
+  setCpuThreads(3);
+  // Calls from inside a chunk (on the calling thread and on the pool's) while the pool
+  // runs their outer call.
+  constexpr std::ptrdiff_t kOuter = 6, kInner = 3000;
+  std::vector<std::vector<int>> visits(kOuter, std::vector<int>(kInner, 0));
+  parallelFor(kOuter, 1, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    for (std::ptrdiff_t i = begin; i < end; ++i) {
+      auto& row = visits[static_cast<std::size_t>(i)];
+      parallelFor(kInner, 1, [&](std::ptrdiff_t b, std::ptrdiff_t e) {
+        for (std::ptrdiff_t j = b; j < e; ++j) ++row[static_cast<std::size_t>(j)];
+      });
+    }
+  });
+  for (const auto& row : visits) EXPECT_EQ(std::count(row.begin(), row.end(), 1), kInner);
+
+  // Calls from several threads at once (one gets the pool, the others threads of their
+  // own), each many times in a row.
+  constexpr int kCallers = 4, kRepeats = 200;
+  std::vector<std::vector<int>> sums(kCallers, std::vector<int>(1000, 0));
+  std::vector<std::thread> callers;
+  for (int c = 0; c < kCallers; ++c) {
+    callers.emplace_back([&sums, c] {
+      auto& mine = sums[static_cast<std::size_t>(c)];
+      for (int r = 0; r < kRepeats; ++r) {
+        parallelFor(static_cast<std::ptrdiff_t>(mine.size()), 1, [&](std::ptrdiff_t b, std::ptrdiff_t e) {
+          for (std::ptrdiff_t j = b; j < e; ++j) ++mine[static_cast<std::size_t>(j)];
+        });
+      }
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (const auto& mine : sums) EXPECT_EQ(std::count(mine.begin(), mine.end(), kRepeats), 1000);
+}
+
 TEST_F(ParallelFor, TheThreadCountIsTheChosenOneElsePlanoThreadsElseEveryCore) {
   if (std::getenv("PLANO_THREADS") == nullptr) {
     EXPECT_EQ(cpuThreads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
