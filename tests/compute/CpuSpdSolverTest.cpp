@@ -85,6 +85,8 @@ TEST(CpuSpdSolver, SolvesToRoundingAndRefusesIndefiniteMatricesWithSimplicialAnd
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Numerical);
     }
+    // A solver whose refactorization failed has no factor to solve with.
+    EXPECT_FALSE(solver->solve(B, X).converged) << A->rows() << " rows";
   }
 }
 

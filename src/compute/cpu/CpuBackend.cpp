@@ -59,7 +59,7 @@ class CholeskyFactor final : public Eigen::CholmodDecomposition<Eigen::SparseMat
   /// the ADMM solves thousands of times with one factor, and each solve allocated (and,
   /// at these sizes, mapped and zeroed) three n x k arrays.
   bool solveInto(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
-    if (!m_cholmodFactor || !m_factorizationIsOk) return false;
+    if (!m_cholmodFactor || !m_factorizationIsOk || info() != Eigen::Success) return false;
     cholmod_dense b{};
     b.nrow = static_cast<std::size_t>(B.rows());
     b.ncol = static_cast<std::size_t>(B.cols());
