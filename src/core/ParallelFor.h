@@ -25,8 +25,8 @@ int cpuThreads();
 void setCpuThreads(int threads);
 
 /// body(begin, end) over [0, count) in contiguous chunks, one per thread, each of at least
-/// `minimumChunk` items (fewer threads for less work: starting a thread costs about as
-/// much as a few hundred faces' fits); the calling thread runs the first chunk. Returns
+/// `minimumChunk` items (fewer threads for less work: handing a chunk to a pool thread costs
+/// ~10 us, starting one tens of microseconds, as much as a few faces' fits); the calling thread runs the first chunk. Returns
 /// once every chunk is done; an exception thrown by a chunk is rethrown then (the lowest
 /// chunk's when several throw).
 void parallelFor(std::ptrdiff_t count, std::ptrdiff_t minimumChunk,

@@ -174,8 +174,9 @@ class CholmodSpdSolver final : public SpdSolver {
   CholeskyFactor factor_;
 };
 
-/// Items per thread at the least (core/ParallelFor.h): a thread's start (tens of
-/// microseconds) pays only for chunks that take far longer, 512 fits (~5 us each) or
+/// Items per thread at the least (core/ParallelFor.h): handing a chunk to another thread
+/// (~10 us from the pool, tens of microseconds when a thread is started) pays only for
+/// chunks that take far longer, 512 fits (~5 us each) or
 /// 16 384 planarities (~20 ns each).
 constexpr std::ptrdiff_t kPlanaritiesPerThread = 16384;
 constexpr std::ptrdiff_t kFitsPerThread = 512;
