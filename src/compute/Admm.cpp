@@ -175,24 +175,27 @@ class HostAdmmKernels final : public AdmmKernels {
 
   AdmmMeasures measure() override {
     AdmmMeasures s;
-    const Eigen::MatrixXd Cx = C_ * x_;
-    const Eigen::MatrixXd Px = P_ * x_;
-    const Eigen::MatrixXd Cty = Ct_ * y_;
-    const Eigen::MatrixXd dy = y_ - yPrevious_;
-    s.primalResidual = columnInfNorms(Cx - z_);
-    s.dualResidual = columnInfNorms(Px + q_ + Cty);
-    s.Cx = columnInfNorms(Cx);
+    // The products as row passes over the threads into kept arrays (the same sums as the
+    // matrix products, bit for bit), the norms of their sums as expressions.
+    multiplyRows(C_, x_, Cx_);
+    multiplyRows(P_, x_, Px_);
+    multiplyRows(Ct_, y_, Cty_);
+    dy_ = y_ - yPrevious_;
+    multiplyRows(Ct_, dy_, Ctdy_);
+    s.primalResidual = columnInfNorms(Cx_ - z_);
+    s.dualResidual = columnInfNorms(Px_ + q_ + Cty_);
+    s.Cx = columnInfNorms(Cx_);
     s.z = columnInfNorms(z_);
-    s.Px = columnInfNorms(Px);
-    s.Cty = columnInfNorms(Cty);
+    s.Px = columnInfNorms(Px_);
+    s.Cty = columnInfNorms(Cty_);
     s.q = columnInfNorms(q_);
     s.x = columnInfNorms(x_);
     s.y = columnInfNorms(y_);
-    s.dy = columnInfNorms(dy);
-    s.Ctdy = columnInfNorms(Ct_ * dy);
-    s.support.resize(dy.cols());
-    for (Eigen::Index c = 0; c < dy.cols(); ++c) {
-      s.support[c] = upper_.col(c).dot(dy.col(c).cwiseMax(0.0)) + lower_.col(c).dot(dy.col(c).cwiseMin(0.0));
+    s.dy = columnInfNorms(dy_);
+    s.Ctdy = columnInfNorms(Ctdy_);
+    s.support.resize(dy_.cols());
+    for (Eigen::Index c = 0; c < dy_.cols(); ++c) {
+      s.support[c] = upper_.col(c).dot(dy_.col(c).cwiseMax(0.0)) + lower_.col(c).dot(dy_.col(c).cwiseMin(0.0));
     }
     s.linearIterations = linearIterations_;
     return s;
@@ -214,6 +217,7 @@ class HostAdmmKernels final : public AdmmKernels {
   Eigen::VectorXd rho_;
   Eigen::MatrixXd q_, lower_, upper_, x_, y_, z_, xTilde_, yPrevious_;
   Eigen::MatrixXd w_, rhs_;  ///< iterate()'s rho z - y and right-hand side, kept to spare their allocations.
+  Eigen::MatrixXd Cx_, Px_, Cty_, dy_, Ctdy_;  ///< measure()'s products, kept likewise.
   long linearIterations_ = 0;
 };
 

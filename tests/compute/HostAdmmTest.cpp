@@ -69,6 +69,7 @@ compute::AdmmSettings oneBlock(int iterations) {
 
 struct Iterate {
   Eigen::MatrixXd x, y, z;
+  compute::AdmmInfo info;  ///< The host loop's: its residuals measured at the last check.
 };
 
 Iterate hostLoop(const Problem& p, const compute::AdmmSettings& settings, int threads) {
@@ -76,7 +77,7 @@ Iterate hostLoop(const Problem& p, const compute::AdmmSettings& settings, int th
   compute::CpuBackend cpu;
   auto solver = cpu.createAdmmSolver(p.P, p.C, settings);
   Iterate it;
-  solver->solve(p.q, p.lower, p.upper, it.x, it.y, it.z);
+  it.info = solver->solve(p.q, p.lower, p.upper, it.x, it.y, it.z);
   setCpuThreads(0);
   return it;
 }
@@ -98,7 +99,7 @@ Iterate matrixExpressions(const Problem& p, const compute::AdmmSettings& setting
   linear.measureResidual = false;
   auto solver = cpu.createSpdSolver(K, linear);
   const double alpha = settings.relaxation;
-  Iterate it{Eigen::MatrixXd::Zero(n, k), Eigen::MatrixXd::Zero(m, k), Eigen::MatrixXd()};
+  Iterate it{Eigen::MatrixXd::Zero(n, k), Eigen::MatrixXd::Zero(m, k), Eigen::MatrixXd(), {}};
   it.z = (p.C * it.x).cwiseMax(p.lower).cwiseMin(p.upper);
   Eigen::MatrixXd xTilde = it.x;
   for (int i = 0; i < settings.maxIterations; ++i) {
@@ -129,6 +130,10 @@ TEST(HostAdmm, IteratesAreTheMatrixExpressionsBitForBitOnOneAndSeveralThreads) {
       EXPECT_TRUE(host.x == reference.x);
       EXPECT_TRUE(host.y == reference.y);
       EXPECT_TRUE(host.z == reference.z);
+      // The check after the block measured the final iterate with its own row passes.
+      EXPECT_EQ(host.info.primalResidual, (p.C * reference.x - reference.z).cwiseAbs().maxCoeff());
+      EXPECT_EQ(host.info.dualResidual,
+                (p.P * reference.x + p.q + compute::SparseMatrix(p.C.transpose()) * reference.y).cwiseAbs().maxCoeff());
     }
   }
 }
