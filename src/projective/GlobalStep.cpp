@@ -230,13 +230,13 @@ GlobalStepInfo GlobalStep::project(const compute::DeviceMatrix& T, const compute
   compute::RelaxedBounds bounds{std::move(d), std::vector<char>(m), 0.0};
   for (Eigen::Index r = 0; r < m; ++r) bounds.relaxed[r] = !positional[r];
 
-  solveEpsilonSchedule(qp, T, bounds, settings_, "global step", info, x);
+  solveEpsilonSchedule(qp, T, bounds, settings_, "global step", info, x, &scheduleMemory_);
   return info;
 }
 
 void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compute::RelaxedBounds& bounds,
                           const GlobalStepSettings& settings, const std::string& what, GlobalStepInfo& info,
-                          compute::DeviceMatrix& x) {
+                          compute::DeviceMatrix& x, EpsilonScheduleMemory* memory) {
   // q = -T; measured where the QP runs, which keeps q and d for the attempts.
   const compute::DeviceMatrix q = T.negated();
   info.initialViolation = bounds.centre.rows() > 0 ? qp.violationAt(q, bounds, T) : 0.0;
@@ -269,8 +269,22 @@ void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compu
     }
   }
 
+  // Attempts at fractions of the violation that stalled in the last two steps of the loop
+  // (GlobalStepSettings::stalledAttemptSkips); never an exact one, nor the last.
+  const double skipFraction = memory ? std::min(memory->lastStalledFraction, memory->earlierStalledFraction) : 0.0;
+  const bool skipping = skipFraction > 0.0 && settings.stalledAttemptSkips > 0 &&
+                        memory->skippingSteps < settings.stalledAttemptSkips;
+  double stalledFraction = skipping ? skipFraction : 0.0;
   bool solved = false;
-  for (double eps : schedule) {
+  for (std::size_t a = 0; a < schedule.size(); ++a) {
+    const double eps = schedule[a];
+    if (skipping && eps > 0.0 && a + 1 < schedule.size() &&
+        eps <= (1.0 + 1e-9) * skipFraction * info.initialViolation) {
+      EpsilonAttempt skipped{eps, BoxQpStatus::Stalled, 0, false};
+      skipped.skipped = true;
+      info.attempts.push_back(skipped);
+      continue;
+    }
     throwIfCancelled(("the " + what).c_str());
     bounds.epsilon = eps;
     // Every attempt starts from the targets: an infeasible attempt leaves diverging duals
@@ -305,7 +319,13 @@ void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compu
     // attempts too slow to converge within it stopped as stalled too: 2 100).
     if (qpInfo.status == BoxQpStatus::Stalled || qpInfo.status == BoxQpStatus::MaxIterationsReached) {
       qp.setRho(startRho);
+      if (eps > 0.0) stalledFraction = std::max(stalledFraction, eps / info.initialViolation);
     }
+  }
+  if (memory) {
+    memory->skippingSteps = skipping ? memory->skippingSteps + 1 : 0;
+    memory->earlierStalledFraction = memory->lastStalledFraction;
+    memory->lastStalledFraction = stalledFraction;
   }
   if (!solved) {
     throwNumerical(what + ": no feasible relaxation found; eps grew from " + formatDouble(schedule.front()) +

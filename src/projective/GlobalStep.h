@@ -66,6 +66,19 @@ struct GlobalStepSettings {
   /// geometrically (n = 2 and growth 10: 10^(1/3) and 10^(2/3) times the failed eps).
   /// 0: the paper's schedule alone.
   int intermediateAttempts = 0;
+  /// A loop's steps skip the attempts at eps up to a fraction of the violation at which an
+  /// attempt stalled or reached the ADMM's cap in each of the last two steps, for this many
+  /// steps in a row; the step after them tries the whole schedule again (0: every step tries
+  /// it). Such attempts stall again while the targets move little from one step to the
+  /// next, and a skipped attempt that would have stalled changes nothing: the next one
+  /// starts at the rho it would have started at (a stalled attempt's start rho, which is
+  /// restored). Two steps, not one: a level's first step starts from the linear scheme's
+  /// points, and an attempt that stalled there converged in the next step (a 3-ring dome's
+  /// second Catmull-Clark level: 2 iterations, or 5 when skipped after one step).
+  /// Measured on the CPU (README, "Skipped attempts"): the Enneper hexagons' first
+  /// Catmull-Clark level, whose attempts at 1e-2 and 1e-1 of the violation stall in every
+  /// step, spent 65 % of its ADMM iterations in stalled attempts.
+  int stalledAttemptSkips = 3;
   /// The QP's settings. On an iterative backend the inner solves with K of more than 128
   /// faces use the aggregation multigrid over faces (compute/BlockMultigrid.h): several
   /// times fewer PCG iterations than face blocks, and the host's ADMM iteration kept where
@@ -102,6 +115,19 @@ struct EpsilonAttempt {
   BoxQpStatus status = BoxQpStatus::MaxIterationsReached;
   int iterations = 0;   ///< ADMM iterations.
   bool direct = false;  ///< Solved (or found infeasible) by the direct equality solve (BoxQpInfo::direct).
+  /// Not tried (GlobalStepSettings::stalledAttemptSkips): an attempt at this fraction of the
+  /// violation stalled in an earlier step; status is Stalled, the outcome expected.
+  bool skipped = false;
+};
+
+/// What a loop's ε schedules carry from one step to the next (GlobalStepSettings::
+/// stalledAttemptSkips).
+struct EpsilonScheduleMemory {
+  /// The last and the step before's largest eps / violation whose attempt stalled, was
+  /// capped, or was skipped (0: none).
+  double lastStalledFraction = 0.0;
+  double earlierStalledFraction = 0.0;
+  int skippingSteps = 0;  ///< Steps in a row that skipped attempts.
 };
 
 enum class GlobalStepStatus {
@@ -202,6 +228,7 @@ class GlobalStep {
   std::vector<Row> rows_;
   ScaledConstraintMatrix constraints_;  ///< C_s: its pattern once, its values per solve.
   std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
+  EpsilonScheduleMemory scheduleMemory_;
 };
 
 /// The paper's ε schedule (§5) on a kept QP, the global steps' (this one's and the multires
@@ -213,9 +240,11 @@ class GlobalStep {
 /// where the ADMM keeps them: the QP's settings must not return duals). x receives the accepted solution where the QP left it; info the
 /// violation, the attempts, their iteration counts and the solution's residuals. `what`
 /// names the step in errors: Error(Numerical) for a non-finite target (naming its face) or
-/// iterate, and for an exhausted schedule.
+/// iterate, and for an exhausted schedule. `memory` (may be null: every attempt tried)
+/// carries the stalled attempts from one step of a loop to the next (GlobalStepSettings::
+/// stalledAttemptSkips).
 void solveEpsilonSchedule(BoxQpSolver& qp, const compute::DeviceMatrix& T, compute::RelaxedBounds& bounds,
                           const GlobalStepSettings& settings, const std::string& what, GlobalStepInfo& info,
-                          compute::DeviceMatrix& x);
+                          compute::DeviceMatrix& x, EpsilonScheduleMemory* memory = nullptr);
 
 }  // namespace plano::projective

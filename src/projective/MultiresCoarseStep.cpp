@@ -132,7 +132,8 @@ GlobalStepInfo MultiresCoarseStep::solveAffine(const compute::DeviceMatrix& line
   BoxQpSolver& qp = keptSolver(qp_, backend_, P_, constraints_, scales, qpSettings);
   GlobalStepInfo info;
   compute::RelaxedBounds bounds{std::move(d), std::move(relaxed), 0.0};
-  solveEpsilonSchedule(qp, linearColumns, bounds, settings_, "coarse global step", info, resultColumns);
+  solveEpsilonSchedule(qp, linearColumns, bounds, settings_, "coarse global step", info, resultColumns,
+                       &scheduleMemory_);
   return info;
 }
 

@@ -59,6 +59,7 @@ class MultiresCoarseStep {
   std::vector<Row> rows_;
   ScaledConstraintMatrix constraints_;  ///< C: its pattern once, its values per solve.
   std::unique_ptr<BoxQpSolver> qp_;  ///< Created by the first solve, kept for the next ones.
+  EpsilonScheduleMemory scheduleMemory_;
 };
 
 }  // namespace plano::projective

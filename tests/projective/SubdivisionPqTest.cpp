@@ -121,6 +121,46 @@ TEST_F(SubdivisionPq, FeasibleNearOptimalAttemptsAreKeptOnAThreeRingDome) {
   EXPECT_GT(inaccurate, 0);
 }
 
+TEST_F(SubdivisionPq, AttemptsThatStalledInTwoStepsAreSkippedWithTheSameResult) {
+  // A 3-ring dome's level held to 0.005 %: five iterations, whose small attempts stall step
+  // after step. Skipping those that stalled in the last two steps
+  // (GlobalStepSettings::stalledAttemptSkips) leaves every iterate as it was: a skipped
+  // attempt would have stalled, and the next one starts at the same rho either way.
+  PqSubdivisionSettings settings;
+  settings.planarityTolerance = 0.005;
+  settings.maxIterationsPerLevel = 8;
+  const PolygonMesh dome = generate::hexagonalDome(3);
+  PqSubdivisionSettings everyAttempt = settings;
+  everyAttempt.globalStep.stalledAttemptSkips = 0;
+  const PqSubdivisionResult tried = subdividePlanarQuads(backend, dome, everyAttempt);
+  const PqSubdivisionResult skipping = subdividePlanarQuads(backend, dome, settings);
+  ASSERT_EQ(skipping.info.levels[0].iterations.size(), tried.info.levels[0].iterations.size());
+  EXPECT_TRUE(skipping.positions.back() == tried.positions.back());
+
+  int skipped = 0, admmSkipping = 0, admmTried = 0;
+  for (std::size_t i = 0; i < tried.info.levels[0].iterations.size(); ++i) {
+    const PqIteration& a = tried.info.levels[0].iterations[i];
+    const PqIteration& b = skipping.info.levels[0].iterations[i];
+    admmTried += a.admmIterations;
+    admmSkipping += b.admmIterations;
+    ASSERT_EQ(a.attempts.size(), b.attempts.size()) << "iteration " << i + 1;
+    for (std::size_t k = 0; k < a.attempts.size(); ++k) {
+      EXPECT_EQ(a.attempts[k].epsilon, b.attempts[k].epsilon);
+      EXPECT_FALSE(a.attempts[k].skipped);
+      if (!b.attempts[k].skipped) continue;
+      ++skipped;
+      EXPECT_EQ(b.attempts[k].iterations, 0);
+      // Skipped only where the full schedule's attempt stalled, and never in the first two steps.
+      EXPECT_TRUE(a.attempts[k].status == BoxQpStatus::Stalled ||
+                  a.attempts[k].status == BoxQpStatus::MaxIterationsReached)
+          << "iteration " << i + 1 << ", attempt " << k + 1 << ": " << toString(a.attempts[k].status);
+      EXPECT_GE(i, 2u);
+    }
+  }
+  EXPECT_GT(skipped, 0);
+  EXPECT_LT(admmSkipping, admmTried);
+}
+
 TEST_F(SubdivisionPq, DodecahedronFourPointAttemptsTooSlowForTheCapStopEarly) {
   // Level 1's second global step has an attempt whose primal residual falls ~2 % per 200
   // ADMM iterations at rho's clamp: it ran to the 4000-iteration cap (5 870 ADMM iterations

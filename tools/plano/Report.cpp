@@ -18,8 +18,8 @@ nlohmann::json epsilonAttemptsJson(const std::vector<projective::EpsilonAttempt>
   nlohmann::json list = nlohmann::json::array();
   for (const auto& a : attempts) {
     list.push_back({{"epsilon", a.epsilon},
-                    {"status", projective::toString(a.status)},
-                    {"method", a.direct ? "equality" : "admm"},
+                    {"status", a.skipped ? "skipped" : projective::toString(a.status)},
+                    {"method", a.skipped ? "none" : a.direct ? "equality" : "admm"},
                     {"iterations", a.iterations}});
   }
   return list;

@@ -1,6 +1,7 @@
 // plano subdivide MESH (-o OUT | --in-place) --scheme catmull-clark|four-point --levels K
 //   [--tolerance PERCENT] [--max-iterations N] [--linear] [--report R.json] [--keep-partial]
 // Planar-quad subdivision (projective-maps paper, §5).
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -95,9 +96,12 @@ RunFunction setup(CLI::App& app) {
     // One line per local/global iteration: a level of a large mesh runs for minutes.
     const auto callback = [&](int level, int iteration, const projective::PqIteration& it) {
       std::ostringstream line;
+      const auto skipped = std::count_if(it.attempts.begin(), it.attempts.end(), [](const auto& a) { return a.skipped; });
+      const auto tried = static_cast<std::ptrdiff_t>(it.attempts.size()) - skipped;
       line << std::setprecision(3) << "level " << level << ", iteration " << iteration << ": max planarity "
            << it.maxPlanarity << "%, change " << it.maxChange << ", eps " << it.epsilon << ", ADMM "
-           << it.admmIterations << " in " << it.attempts.size() << (it.attempts.size() == 1 ? " attempt" : " attempts");
+           << it.admmIterations << " in " << tried << (tried == 1 ? " attempt" : " attempts");
+      if (skipped > 0) line << " (" << skipped << " skipped: stalled before)";
       progress(global, line.str());
     };
     const projective::PqSubdivisionResult result =
