@@ -40,8 +40,8 @@ bool allFinite(const Eigen::VectorXd& v) { return v.allFinite(); }
 /// ParallelFor.h's pool; BM_ParallelForCall).
 constexpr std::ptrdiff_t kRowsPerThread = 4096;
 
-/// A row function inlined into the row loop of forEachRowProduct: GCC at -O3 left the ADMM
-/// pass's a call per row and column when Admm.cpp was compiled on its own, not in a unity
+/// A row function inlined into the row loop of forEachRowProduct: GCC at -O3 left a call per
+/// row and column in the ADMM's passes when Admm.cpp was compiled on its own, not in a unity
 /// batch (the Enneper hexagons' first four iterations 15.1-15.5 s against 13.2-14.4 s).
 #define PLANO_ROW_FUNCTION __attribute__((always_inline))
 
