@@ -70,9 +70,9 @@ struct GlobalStepSettings {
   /// attempt stalled or reached the ADMM's cap in each of the last two steps, for this many
   /// steps in a row; the step after them tries the whole schedule again (0: every step tries
   /// it). Such attempts stall again while the targets move little from one step to the
-  /// next, and a skipped attempt that would have stalled changes nothing: the next one
+  /// next, and a skipped attempt that would have stalled changes little: the next one
   /// starts at the rho it would have started at (a stalled attempt's start rho, which is
-  /// restored). Two steps, not one: a level's first step starts from the linear scheme's
+  /// restored); the subdivisions measured end the same bit for bit. Two steps, not one: a level's first step starts from the linear scheme's
   /// points, and an attempt that stalled there converged in the next step (a 3-ring dome's
   /// second Catmull-Clark level: 2 iterations, or 5 when skipped after one step).
   /// Measured on the CPU (README, "Skipped attempts"): the Enneper hexagons' first
