@@ -75,6 +75,33 @@ TEST(SubdivisionCommand, PrintsAProgressLinePerIterationUnlessQuiet) {
   EXPECT_EQ(quiet.err.find("iteration"), std::string::npos) << quiet.err;
 }
 
+TEST(SubdivisionCommand, ReportsAndPrintsTheSkippedAttempts) {
+  // A 3-ring dome's level held to 0.005 %: its small attempts stall in two steps, and the
+  // later steps skip them (GlobalStepSettings::stalledAttemptSkips).
+  test::TempDir dir;
+  writeMesh(dir / "dome.obj", generate::hexagonalDome(3));
+  const auto result = test::runTool("subdivide " + (dir / "dome.obj").string() + " -o " + (dir / "fine.obj").string() +
+                                    " --levels 1 --tolerance 0.005 --max-iterations 8 --report " +
+                                    (dir / "report.json").string());
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::ifstream in(dir / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  int skipped = 0;
+  for (const auto& step : report["levels"][0]["steps"]) {
+    int stepSkipped = 0;
+    for (const auto& attempt : step["epsilon_attempts"]) {
+      if (attempt["status"] != "skipped") continue;
+      ++stepSkipped;
+      EXPECT_EQ(attempt["method"], "none");
+      EXPECT_EQ(attempt["iterations"], 0);
+    }
+    EXPECT_NE(step["epsilon_attempts"].back()["status"], "skipped");
+    skipped += stepSkipped;
+  }
+  EXPECT_GT(skipped, 0);
+  EXPECT_NE(result.err.find(" skipped: stalled before)"), std::string::npos) << result.err;
+}
+
 TEST(SubdivisionCommand, InPlaceLinearFourPointKeepsTheCoarseVertices) {
   test::TempDir dir;
   const PolygonMesh cube = generate::cube();
