@@ -264,6 +264,9 @@ AdmmSolver::AdmmSolver(std::unique_ptr<AdmmKernels> kernels, Eigen::Index n, Eig
   for (const double alpha : {settings_.relaxation, settings_.equalityRelaxation}) {
     if (!(alpha > 0.0 && alpha < 2.0)) throwUsage("ADMM: the over-relaxations must be in (0, 2)");
   }
+  if (!(settings_.dualToleranceScale >= 1.0) || std::isinf(settings_.dualToleranceScale)) {
+    throwUsage("ADMM: dualToleranceScale must be a finite number >= 1");
+  }
   if (std::isnan(settings_.inaccurateDualFactor)) throwUsage("ADMM: inaccurateDualFactor must be a number");
   if (!(settings_.linearToleranceFraction > 0.0) || !std::isfinite(settings_.linearToleranceFraction)) {
     throwUsage("ADMM: linearToleranceFraction must be a finite number > 0");
@@ -484,7 +487,8 @@ AdmmInfo AdmmSolver::run(const DeviceMatrix& q, const Eigen::MatrixXd& lower, co
     const double primalScale = std::max(maxOf(s.Cx), maxOf(s.z));
     const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
     const double epsPrimal = primalAbsoluteTolerance + settings_.relativeTolerance * primalScale;
-    const double epsDual = settings_.absoluteTolerance + settings_.relativeTolerance * dualScale;
+    const double epsDual =
+        settings_.dualToleranceScale * (settings_.absoluteTolerance + settings_.relativeTolerance * dualScale);
     primalTolerance = epsPrimal;
     dualTolerance = epsDual;
     if (!regular) return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;

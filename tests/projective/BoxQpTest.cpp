@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -426,6 +427,55 @@ TEST(BoxQp, TheAdmmReportsEachConvergenceCheckToItsCallback) {
   EXPECT_EQ(checks.back().linearIterations, info.linearIterations);
   EXPECT_LE(checks.back().primalResidual, checks.back().primalTolerance);
   EXPECT_LE(checks.back().dualResidual, checks.back().dualTolerance);
+}
+
+TEST(BoxQp, ADualToleranceScaleLoosensOnlyTheDualTolerance) {
+  // rho held high: the primal residual converges first and the dual one decides the stop.
+  const EqualityQp qp = consistentEqualityQp(40, 13, 2, 2);
+  const Eigen::MatrixXd lower = qp.d.array() - 0.01, upper = qp.d.array() + 0.01;
+  compute::CpuBackend backend;
+  const auto solveWithScale = [&](double scale, std::vector<compute::AdmmCheck>& checks) {
+    BoxQpSettings settings;
+    settings.polish = false;
+    settings.adaptiveRho = false;
+    settings.rho = 100.0;
+    settings.dualToleranceScale = scale;
+    settings.onCheck = [&](const compute::AdmmCheck& check) { checks.push_back(check); };
+    BoxQpSolver solver(backend, qp.P, qp.C, settings);
+    Eigen::MatrixXd x, y;
+    return solver.solve(qp.q, lower, upper, x, y);
+  };
+  std::vector<compute::AdmmCheck> tight, loose;
+  const BoxQpInfo tightInfo = solveWithScale(1.0, tight);
+  const BoxQpInfo looseInfo = solveWithScale(10.0, loose);
+  ASSERT_EQ(tightInfo.status, BoxQpStatus::Solved);
+  ASSERT_EQ(looseInfo.status, BoxQpStatus::Solved);
+  ASSERT_FALSE(tight.empty());
+  ASSERT_FALSE(loose.empty());
+  // The same iteration up to the looser stop: the first checks see the same iterate.
+  EXPECT_EQ(loose.front().primalResidual, tight.front().primalResidual);
+  EXPECT_EQ(loose.front().primalTolerance, tight.front().primalTolerance);
+  EXPECT_DOUBLE_EQ(loose.front().dualTolerance, 10.0 * tight.front().dualTolerance);
+  EXPECT_LT(looseInfo.iterations, tightInfo.iterations);
+  EXPECT_LE(loose.back().primalResidual, loose.back().primalTolerance);
+  EXPECT_LE(loose.back().dualResidual, loose.back().dualTolerance);
+  EXPECT_GT(loose.back().dualResidual, tight.back().dualTolerance) << "the case must stop on the looser tolerance";
+}
+
+TEST(BoxQp, ADualToleranceScaleBelowOneIsAUsageError) {
+  const EqualityQp qp = consistentEqualityQp(6, 2, 1, 5);
+  compute::CpuBackend backend;
+  for (const double scale : {0.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    BoxQpSettings settings;
+    settings.dualToleranceScale = scale;
+    try {
+      BoxQpSolver solver(backend, qp.P, qp.C, settings);
+      ADD_FAILURE() << "expected Error(Usage) for scale " << scale;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage);
+      EXPECT_NE(std::string(e.what()).find("dualToleranceScale"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
