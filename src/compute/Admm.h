@@ -71,10 +71,11 @@ struct AdmmSettings {
   double equalityRelaxation = 1.3;
   double absoluteTolerance = 1e-6;       ///< eps_abs of the primal and dual residuals (inf-norms).
   double relativeTolerance = 1e-6;       ///< eps_rel, relative to the sizes of the terms.
-  /// The dual residual's tolerances (absolute and relative) are this many times the primal
-  /// one's (>= 1). A local/global loop needs its global steps' constraints met tightly
-  /// (planarity rests on them) but their optimality only as closely as the next local
-  /// step's refit can tell: PQ subdivision sets 10 (PqSubdivisionSettings::globalStep).
+  /// The dual residual's tolerance is this many times what absoluteTolerance and
+  /// relativeTolerance give it (>= 1; the primal one's stays). A local/global loop needs
+  /// its global steps' constraints met tightly (planarity rests on them) but their
+  /// optimality only as closely as the next local step's refit can tell: PQ subdivision
+  /// sets 10 (PqSubdivisionSettings::globalStep).
   double dualToleranceScale = 1.0;
   double infeasibilityTolerance = 1e-6;  ///< eps of the primal infeasibility certificate.
   /// With relaxed bounds (RelaxedBounds: rows within eps of their centre, an eps schedule's

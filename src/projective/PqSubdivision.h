@@ -53,8 +53,8 @@ struct PqSubdivisionSettings {
   /// level reaches the 0.1 % bound (0.095 % after 14 iterations, 44 s, where it stopped at
   /// 0.136 % after 20, 125 s); the cube's, dodecahedron's and domes' levels take 16-51 %
   /// fewer ADMM iterations, but one that now makes progress where its first step kept
-  /// its targets (2-ring dome, four-point: 6.6x flatter, 39 % more). Deformations keep the ADMM's own tolerance (their backends' meshes must
-  /// agree to 1e-6 of the diagonal).
+  /// its targets (2-ring dome, four-point: 6.6x flatter, 39 % more). Deformations keep
+  /// the ADMM's own tolerance (their backends' meshes must agree to 1e-6 of the diagonal).
   GlobalStepSettings globalStep = [] {
     GlobalStepSettings s;
     s.qp.dualToleranceScale = 10.0;
