@@ -487,8 +487,7 @@ AdmmInfo AdmmSolver::run(const DeviceMatrix& q, const Eigen::MatrixXd& lower, co
     const double primalScale = std::max(maxOf(s.Cx), maxOf(s.z));
     const double dualScale = std::max({maxOf(s.Px), maxOf(s.Cty), maxOf(s.q)});
     const double epsPrimal = primalAbsoluteTolerance + settings_.relativeTolerance * primalScale;
-    const double epsDual =
-        settings_.dualToleranceScale * (settings_.absoluteTolerance + settings_.relativeTolerance * dualScale);
+    const double epsDual = dualToleranceFor(settings_, dualScale);
     primalTolerance = epsPrimal;
     dualTolerance = epsDual;
     if (!regular) return info.primalResidual <= epsPrimal && info.dualResidual <= epsDual;

@@ -161,6 +161,13 @@ struct AdmmSettings {
   bool smoothedMultigrid = false;
 };
 
+/// The dual residual's tolerance for terms of inf-norm `scale` (the largest of ||P x||,
+/// ||C^T y|| and ||q||): the ADMM's convergence test, and the direct equality solves' that
+/// mirror it (projective/BoxQp.cpp).
+inline double dualToleranceFor(const AdmmSettings& settings, double scale) {
+  return settings.dualToleranceScale * (settings.absoluteTolerance + settings.relativeTolerance * scale);
+}
+
 enum class AdmmStatus {
   Solved,               ///< Primal and dual residuals below their tolerances.
   PrimalInfeasible,     ///< An infeasibility certificate was found (no x satisfies the bounds).

@@ -466,9 +466,8 @@ bool BoxQpSolver::solveEqualities(const Eigen::MatrixXd& q, const Eigen::MatrixX
     info.dualResidual = infNorm(dual);
     for (Eigen::Index c = 0; c < k; ++c) {
       if (!(norm(primal, c) <= primalTolerance(Cx, c))) return false;
-      const double dualTolerance =
-          settings_.dualToleranceScale *
-          (settings_.absoluteTolerance + settings_.relativeTolerance * std::max({norm(Px, c), norm(Cty, c), norm(q, c)}));
+      const double dualScale = std::max({norm(Px, c), norm(Cty, c), norm(q, c)});
+      const double dualTolerance = compute::dualToleranceFor(settings_, dualScale);
       if (checkDual && !(norm(dual, c) <= dualTolerance)) return false;
     }
     return true;

@@ -72,9 +72,10 @@ struct GlobalStepSettings {
   /// it). Such attempts stall again while the targets move little from one step to the
   /// next, and a skipped attempt that would have stalled changes little: the next one
   /// starts at the rho it would have started at (a stalled attempt's start rho, which is
-  /// restored); the subdivisions measured end the same bit for bit. Two steps, not one: a level's first step starts from the linear scheme's
-  /// points, and an attempt that stalled there converged in the next step (a 3-ring dome's
-  /// second Catmull-Clark level: 2 iterations, or 5 when skipped after one step).
+  /// restored); the subdivisions measured end the same bit for bit. Two steps, not one: a
+  /// level's first step starts from the linear scheme's points, and an attempt that stalled
+  /// there converged in the next step (a 3-ring dome's second Catmull-Clark level: 2
+  /// iterations, or 5 when skipped after one step).
   /// Measured on the CPU (README, "Skipped attempts"): the Enneper hexagons' first
   /// Catmull-Clark level, whose attempts at 1e-2 and 1e-1 of the violation stall in every
   /// step, spent 65 % of its ADMM iterations in stalled attempts.
@@ -237,8 +238,8 @@ class GlobalStep {
 /// eps grows by epsilonGrowth until an attempt converges. Each attempt starts from the
 /// targets T (4 #F x 3, possibly a device matrix) with zero duals, or, an ε = 0 attempt
 /// after the last step's solved one, with that one's (BoxQpSettings::warmStartEqualities,
-/// where the ADMM keeps them: the QP's settings must not return duals). x receives the accepted solution where the QP left it; info the
-/// violation, the attempts, their iteration counts and the solution's residuals. `what`
+/// where the ADMM keeps them: the QP's settings must not return duals). x receives the
+/// accepted solution where the QP left it; info the violation, the attempts, their iteration counts and the solution's residuals. `what`
 /// names the step in errors: Error(Numerical) for a non-finite target (naming its face) or
 /// iterate, and for an exhausted schedule. `memory` (may be null: every attempt tried)
 /// carries the stalled attempts from one step of a loop to the next (GlobalStepSettings::
