@@ -286,6 +286,20 @@ struct ActiveSetRefinement {
   /// residual (the next, tight, decides the rounding floor). Near the solution (the ADMM's
   /// polish) a tight solve lets a fast contraction reach rounding in a few refinements.
   bool farStart = false;
+  /// Each refinement solves for its step from the iterate instead of for the new point:
+  ///   K_A dx = -(P x + q + C^T lambda) - rho C^T diag(active) (C x - b),   x += dx,
+  /// the same refinement in exact arithmetic. The new point's right-hand side carries the
+  /// rho-sized term rho C^T b, whose rounding (~1e-16 rho |x|) an iterative solve cannot
+  /// get below; the step's shrinks with the residual. So a stiff rho, whose refinements
+  /// contract far faster, keeps its accuracy (projective/BoxQp.h, kIterativeExactStepRho).
+  /// Each solve then starts from zero, to its tolerance relative to its right-hand side.
+  bool forSteps = false;
+  /// When > 0 (with a reach): refinements at rho that would not reach `reach` go on from
+  /// where they are at this stiffer penalty, solving for their steps (forSteps), instead
+  /// of giving up; the reach is then judged again on their own contraction. A mild rho's
+  /// refinements for the new point are the cheap ones where they contract (their solves
+  /// warm-started near the answer); the stiff ones contract where those crawl.
+  double stiffRho = 0.0;
 };
 
 /// What refineActiveSet did.

@@ -76,6 +76,10 @@ BoxQpSolver::BoxQpSolver(compute::Backend& backend, compute::SparseMatrix P, com
   if (!(settings_.polishRho >= 0.0) || std::isinf(settings_.polishRho)) {
     throwUsage("box QP: the polish's rho must be a finite number >= 0 (0: automatic)");
   }
+  if (!(settings_.equalityPolishStiffRho >= 0.0) || std::isinf(settings_.equalityPolishStiffRho)) {
+    throwUsage("box QP: equalityPolishStiffRho (the exact-step polish's stiff rho) must be a finite number >= 0 "
+               "(0: none)");
+  }
   if (settings_.polishRho == 0.0) {
     settings_.polishRho = backend_.factorsSpdMatrices() ? kFactoredPolishRho : kIterativePolishRho;
   }
@@ -239,7 +243,7 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
   info.dualResidual = admm.dualResidual;
   info.rho = admm.rho;
   const bool polishing = isSolved(info.status) && settings_.polish && info.iterations > 0;
-  if (polishing && polishInPlace(lower, upper, info, settings_.inPlacePolishIterations)) {
+  if (polishing && polishInPlace(lower, upper, info, {settings_.inPlacePolishIterations})) {
     return finishSolve(info, lower, upper, allEqualities, true, x, y, kept);
   }
   if (polishing) {
@@ -289,8 +293,12 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
   }
   const double largestTarget = bounds.size() > 0 ? bounds.cwiseAbs().maxCoeff() : 0.0;
   const double accepted = kEqualityPolishResidual * std::max(1.0, largestTarget);
-  if (!polishInPlace(bounds, bounds, info, settings_.equalityPolishIterations, accepted, true,
-                     kEqualityPolishGoal * accepted)) {
+  InPlacePolish how{settings_.equalityPolishIterations};
+  how.reach = accepted;
+  how.farStart = true;
+  how.goal = kEqualityPolishGoal * accepted;
+  how.stiffRho = settings_.equalityPolishStiffRho;
+  if (!polishInPlace(bounds, bounds, info, how)) {
     return false;  // the kernels cannot: untouched
   }
   info.factorizations = 1;  // K_A, as a direct solve's
@@ -306,7 +314,7 @@ bool BoxQpSolver::solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const 
 }
 
 bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                                int maxRefinements, double reach, bool farStart, double goal) {
+                                const InPlacePolish& how) {
   std::vector<compute::BoundSide> sides;
   if (!admm_->findActiveSides(sides)) return false;
   const Eigen::Index m = C_.rows();
@@ -335,11 +343,17 @@ bool BoxQpSolver::polishInPlace(const Eigen::MatrixXd& lower, const Eigen::Matri
         if (side == compute::BoundSide::Upper) largestTarget = std::max(largestTarget, std::abs(upper(i, c)));
       }
     }
-    compute::ActiveSetRefinement request{active, Eigen::MatrixXd(), columns, settings_.polishRho, maxRefinements,
-                                         std::max(goal, kRoundingGoal * std::max(1.0, largestTarget)), sides,
+    compute::ActiveSetRefinement request{active,
+                                         Eigen::MatrixXd(),
+                                         columns,
+                                         settings_.polishRho,
+                                         how.maxRefinements,
+                                         std::max(how.goal, kRoundingGoal * std::max(1.0, largestTarget)),
+                                         sides,
                                          true};
-    request.reach = reach;
-    request.farStart = farStart;
+    request.reach = how.reach;
+    request.farStart = how.farStart;
+    request.stiffRho = how.stiffRho;
     compute::ActiveSetRefinementInfo refined;
     Eigen::MatrixXd unusedX, unusedY;
     if (!admm_->refineActiveSet(request, unusedX, unusedY, refined)) {

@@ -74,6 +74,12 @@ inline constexpr double kFactoredPolishRho = 1e9;
 /// refinements), 1e4 9.2e-13 (8 290, 16 refinements); 1e5 with the device polish's rounding
 /// floor (vk::AdmmKernels::kPolishRoundingFloor) 1.1e-11 (5 629).
 inline constexpr double kIterativePolishRho = 1e5;
+/// The stiff penalty of the polish that solves a warm exact step alone on an iterative
+/// backend (EqualitySolve::Automatic), where its refinements at kIterativePolishRho would
+/// not reach rounding (compute::ActiveSetRefinement::stiffRho): they go on solving for
+/// their steps, whose right-hand side leaves no rho-sized rounding, and the stiff penalty
+/// makes the method of multipliers contract fast where the mild one crawls.
+inline constexpr double kIterativeExactStepRho = 1e8;
 
 /// The ADMM's settings (compute::AdmmSettings) and those of the final polish.
 struct BoxQpSettings : compute::AdmmSettings {
@@ -95,9 +101,14 @@ struct BoxQpSettings : compute::AdmmSettings {
   /// multipliers (residual 5e-4) the polish is at 4e-10 after 30 refinements and at rounding
   /// (1e-14) after 60. On the 32x32 grid (1k faces) it stands after ~165 refinements
   /// (1.3e-3 -> 4.5e-13), 4 101 PCG iterations against 10 735 for the ADMM and its polish
-  /// that solved the step when the cap was 60; on 48x48 (2.3k faces) it is given up either
-  /// way (its contraction too slow), 477 PCG iterations later than with 60.
+  /// that solved the step when the cap was 60; on 48x48 (2.3k faces) it was given up either
+  /// way (its contraction too slow), 477 PCG iterations later than with 60, until it went on
+  /// at a stiff penalty instead (equalityPolishStiffRho).
   int equalityPolishIterations = 200;
+  /// The stiff penalty at which that polish goes on where its refinements at polishRho
+  /// would not reach rounding (compute::ActiveSetRefinement::stiffRho); 0: it gives up
+  /// there, and the ADMM solves the step.
+  double equalityPolishStiffRho = kIterativeExactStepRho;
   /// Penalty of the polish's equality system; 0 picks kFactoredPolishRho where the backend
   /// factors SPD matrices (Backend::factorsSpdMatrices), kIterativePolishRho where it iterates.
   double polishRho = 0.0;
@@ -253,12 +264,18 @@ class BoxQpSolver {
   /// flags of each set and a few norms cross, and the iterate stays for the final download.
   /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
   /// untouched: polish() then works from the downloaded iterate).
-  /// At most maxRefinements per set; `reach` > 0 gives up a set's refinements that would
-  /// not reach it (compute::ActiveSetRefinement::reach); `farStart` says the iterate is far
-  /// from the solution (compute::ActiveSetRefinement::farStart); a set's refinements stop
-  /// at a residual of `goal` or at rounding, whichever is larger.
+  struct InPlacePolish {
+    int maxRefinements;  ///< Per set.
+    /// > 0: give up a set's refinements that would not reach it
+    /// (compute::ActiveSetRefinement::reach).
+    double reach = 0.0;
+    bool farStart = false;  ///< compute::ActiveSetRefinement::farStart.
+    /// A set's refinements stop at a residual of `goal` or at rounding, whichever is larger.
+    double goal = 0.0;
+    double stiffRho = 0.0;  ///< compute::ActiveSetRefinement::stiffRho.
+  };
   bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
-                     int maxRefinements, double reach = 0.0, bool farStart = false, double goal = 0.0);
+                     const InPlacePolish& how);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
               const Eigen::MatrixXd& z, Eigen::MatrixXd& x, Eigen::MatrixXd& y, int& refinements);
   /// The direct solve of an all-equality problem (EqualitySolve::Direct) from

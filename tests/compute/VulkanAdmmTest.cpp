@@ -968,6 +968,81 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
   EXPECT_LE(fastWithReachResidual, kGoal);
 }
 
+TEST_F(VulkanAdmm, ARefinementOutOfItsReachGoesOnForItsStepsAtTheStiffPenaltyAndReachesIt) {
+  // ActiveSetRefinement::stiffRho: where the refinements at rho would not reach their
+  // reach, they go on from their iterate at the stiff penalty, solving for their steps,
+  // and get there; with the same request but no stiff penalty they give up after 11, as
+  // in the test above.
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  std::unique_ptr<compute::AdmmSolver> solver;
+  std::vector<char> active;
+  Eigen::MatrixXd targets;
+  ASSERT_NO_FATAL_FAILURE(solvedForRefinement(context(), qp, solver, active, targets));
+  Eigen::MatrixXd xReference, yReference;
+  activeSetReference(qp, active, targets, xReference, yReference);
+  constexpr double kGoal = 1e-12;
+  const auto refine = [&](double stiffRho, double& residual, Eigen::MatrixXd& x) {
+    compute::ActiveSetRefinement request{active, targets, {0}, 1.0, 60, kGoal, {}, false};
+    request.reach = kGoal;
+    request.stiffRho = stiffRho;
+    compute::ActiveSetRefinementInfo info;
+    Eigen::MatrixXd y;
+    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
+    residual = 0.0;
+    const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
+    for (Index i = 0; i < r.size(); ++i) {
+      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
+    }
+    return info.refinements;
+  };
+  double givenUpResidual = 0.0, stiffResidual = 0.0;
+  Eigen::MatrixXd givenUpX, stiffX;
+  const int givenUp = refine(0.0, givenUpResidual, givenUpX);
+  const int stiff = refine(1e8, stiffResidual, stiffX);
+  std::printf("rho 1: given up after %d refinements at %.2e; with the stiff penalty %d refinements to %.2e\n",
+              givenUp, givenUpResidual, stiff, stiffResidual);
+  EXPECT_EQ(givenUp, 11);
+  EXPECT_GT(givenUpResidual, kGoal);
+  EXPECT_GT(stiff, givenUp) << "the stiff refinements follow the given-up ones";
+  EXPECT_LE(stiffResidual, kGoal);
+  EXPECT_LT(relativeDifference(stiffX.col(0), xReference.col(0)), 1e-9);
+}
+
+TEST_F(VulkanAdmm, AStiffPenaltyKeepsItsAccuracyWhenItsRefinementsSolveForTheirSteps) {
+  // ActiveSetRefinement::forSteps, from a far start (targets moved by 1e-3 from the
+  // ADMM's): at rho 1e8 the refinements for the new point solve a right-hand side of
+  // rho-sized terms, whose rounding the PCG cannot get below, and end far from the
+  // active-set solution; those for the step reach it.
+  const BoxQp qp = randomBoxQp(30, 24, 17);
+  const compute::AdmmSettings settings;
+  std::vector<char> active;
+  Eigen::MatrixXd targets;
+  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context(), qp, settings, active, targets));
+  for (Index i = 0; i < targets.rows(); ++i) targets(i, 0) += 1e-3 * std::cos(static_cast<double>(3 * i));
+  Eigen::MatrixXd xReference, yReference;
+  activeSetReference(qp, active, targets, xReference, yReference);
+  const auto refine = [&](bool forSteps, Eigen::MatrixXd& x) {
+    auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
+    runAdmm(*solver, qp);
+    compute::ActiveSetRefinement request{active, targets, {0}, 1e8, 30, 1e-14, {}, false};
+    request.farStart = true;
+    request.forSteps = forSteps;
+    compute::ActiveSetRefinementInfo info;
+    Eigen::MatrixXd y;
+    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
+    return info;
+  };
+  Eigen::MatrixXd pointsX, stepsX;
+  const compute::ActiveSetRefinementInfo points = refine(false, pointsX), steps = refine(true, stepsX);
+  const double pointsError = relativeDifference(pointsX.col(0), xReference.col(0));
+  const double stepsError = relativeDifference(stepsX.col(0), xReference.col(0));
+  std::printf("rho 1e8, for the points: %d refinements, %ld PCG iterations, error %.2e; for the steps: %d, %ld, %.2e\n",
+              points.refinements, points.linearIterations, pointsError, steps.refinements, steps.linearIterations,
+              stepsError);
+  EXPECT_LT(stepsError, 1e-10);
+  EXPECT_GT(pointsError, 100 * stepsError);
+}
+
 TEST_F(VulkanAdmm, AStalledRefinementNearItsGoalStopsAtTheRoundingFloorAndFarFromItGoesOn) {
   // A polish without a reach whose best residual falls by less than half over ten
   // refinements stops there when it is within 1e3 of its goal (the rounding floor of a
@@ -1811,6 +1886,36 @@ TEST_F(VulkanAdmm, AWarmStartedExactStepWhosePolishFallsShortIsSolvedByTheAdmmFr
   EXPECT_LE(device.polishRefinements, 1 + problem.settings.qp.inPlacePolishIterations);
   EXPECT_LT(device.constraintResidual, 1e-12);
   EXPECT_LT(both.mapDifference(), 1e-10);
+}
+
+TEST_F(VulkanAdmm, AWarmStartedExactStepWhoseMildPolishCrawlsIsSolvedAtTheStiffPenaltyWithoutTheAdmm) {
+  // A polish penalty of 1 makes the refinements for the new point crawl, as the polish's
+  // own does on grids of a few thousand faces: their reach fails, and they go on at
+  // BoxQpSettings::equalityPolishStiffRho, solving for their steps, to the CPU's maps
+  // (those of the default penalty: the CPU's direct solve refines with polishRho too). No
+  // ADMM iteration; with no stiff penalty the polish gives up and the ADMM solves the step.
+  GlobalStepCase problem(8);
+  problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
+  const BothBackends reference = solveSecondExactStepOnBothBackends(problem, backend());
+  problem.settings.qp.polishRho = 1.0;
+  BothBackends both = solveSecondExactStepOnBothBackends(problem, backend());
+  both.hostMaps = reference.hostMaps;
+  const projective::GlobalStepInfo& device = both.deviceInfo;
+  ASSERT_EQ(device.attempts.size(), 1u);
+  std::printf("%d refinements, %ld PCG iterations, maps %.2e from the CPU's\n", device.polishRefinements,
+              device.linearIterations, both.mapDifference());
+  EXPECT_EQ(device.status, projective::GlobalStepStatus::Solved);
+  EXPECT_TRUE(device.attempts[0].direct);
+  EXPECT_EQ(device.admmIterations, 0);
+  EXPECT_GT(device.polishRefinements, 11) << "the mild refinements did not give up";
+  EXPECT_LT(device.constraintResidual, 1e-12);
+  EXPECT_LT(both.mapDifference(), 1e-10);
+
+  problem.settings.qp.equalityPolishStiffRho = 0.0;
+  const BothBackends givenUp = solveSecondExactStepOnBothBackends(problem, backend());
+  ASSERT_EQ(givenUp.deviceInfo.attempts.size(), 1u);
+  EXPECT_FALSE(givenUp.deviceInfo.attempts[0].direct);
+  EXPECT_GT(givenUp.deviceInfo.admmIterations, 0);
 }
 
 TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {

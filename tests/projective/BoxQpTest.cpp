@@ -478,6 +478,25 @@ TEST(BoxQp, ADualToleranceScaleBelowOneIsAUsageError) {
   }
 }
 
+TEST(BoxQp, ANegativeOrNonFiniteEqualityPolishStiffRhoIsAUsageError) {
+  const EqualityQp qp = consistentEqualityQp(6, 2, 1, 5);
+  compute::CpuBackend backend;
+  for (const double rho : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    BoxQpSettings settings;
+    settings.equalityPolishStiffRho = rho;
+    try {
+      BoxQpSolver solver(backend, qp.P, qp.C, settings);
+      ADD_FAILURE() << "expected Error(Usage) for " << rho;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage);
+      EXPECT_NE(std::string(e.what()).find("equalityPolishStiffRho"), std::string::npos) << e.what();
+    }
+  }
+  BoxQpSettings none;
+  none.equalityPolishStiffRho = 0.0;
+  EXPECT_NO_THROW(BoxQpSolver(backend, qp.P, qp.C, none));
+}
+
 TEST(BoxQp, WithoutReturnedDualsYComesBackEmptyAndXUnchanged) {
   const EqualityQp qp = consistentEqualityQp(12, 5, 2, 10);
   compute::RelaxedBounds bounds{qp.d, std::vector<char>(5, 1), 0.05};

@@ -195,7 +195,9 @@ class AdmmKernels final : public compute::AdmmKernels {
   void download(Eigen::MatrixXd& x, Eigen::MatrixXd& y, Eigen::MatrixXd& z) override;
   void downloadSolution(Eigen::MatrixXd& x, Eigen::MatrixXd* y) override;
   /// On the device: K_A is assembled as K (the active flags as K1's row scales), each
-  /// refinement is the ADMM's right-hand side (with z = b) and inner PCG, then one update;
+  /// refinement is the ADMM's right-hand side (with z = b) and inner PCG warm-started at x,
+  /// or the step's right-hand side and PCG from zero (ActiveSetRefinement::forSteps, and
+  /// after a switch to stiffRho: K_A formed again at it), then one update;
   /// per refinement only the k residual norms and the PCG state come back. Throws
   /// Error(Usage) for an active set or targets of the wrong size.
   bool refineActiveSet(const compute::ActiveSetRefinement& request, Eigen::MatrixXd& x, Eigen::MatrixXd& y,

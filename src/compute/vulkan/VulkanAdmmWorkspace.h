@@ -205,7 +205,8 @@ struct AdmmKernels::Workspace {
         : x0(context, n, k, "polish start x"), y0(context, m, k, "polish start y"),
           z0(context, m, k, "polish start z"), xKept(context, n, k, "polish result x"), yKept(context, m, k, "polish result y"), save(context),
           begin(context), solve(context), resume(context), looseSolve(context), looseResume(context),
-          update(context) {}
+          stepSolve(context), stepResume(context), looseStepSolve(context), looseStepResume(context),
+          update(context), stepUpdate(context) {}
     DeviceVectors x0, y0;
     DeviceVectors z0;  ///< The ADMM's z: each refinement sets z to its targets, the end restores it.
     DeviceVectors xKept, yKept;  ///< keepResult's: the columns refined since the save, the others x0, y0.
@@ -215,7 +216,11 @@ struct AdmmKernels::Workspace {
     Sequence resume;  ///< More PCG iterations from xTilde (a solve stopped by the recorded cap).
     /// solve and resume to kPolishSolveTolerance ||r0||: the refinements with momentum.
     Sequence looseSolve, looseResume;
+    /// The same for the step (ActiveSetRefinement::forSteps): its right-hand side
+    /// -(P x + q + C^T (lambda + rho diag(active) (C x - b))) and PCG from xTilde = 0.
+    Sequence stepSolve, stepResume, looseStepSolve, looseStepResume;
     Sequence update;  ///< x = xTilde, lambda += rho diag(active) (C x - b), the norms.
+    Sequence stepUpdate;  ///< The same with x += xTilde.
     std::unique_ptr<Sequence> targets;  ///< z = b from the held sides (recorded on first use).
     std::unique_ptr<Sequence> discard;  ///< x = x0, y = y0, z = z0 (recorded on first use).
     /// Nesterov's extrapolation of the multipliers before refinement j after a restart:
