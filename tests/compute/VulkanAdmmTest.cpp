@@ -918,19 +918,38 @@ void solvedForRefinement(vk::Context& context, const BoxQp& qp, std::unique_ptr<
   polishActiveSet(qp, admm, active, targets);
 }
 
-/// The refinements `request` (of column 0, from the solver's iterate) ran, and in
-/// `residual` the largest violation of its active rows after them.
-int refineColumnZero(compute::AdmmSolver& solver, const BoxQp& qp, const compute::ActiveSetRefinement& request,
-                     double& residual) {
-  compute::ActiveSetRefinementInfo info;
-  Eigen::MatrixXd x, y;
-  EXPECT_TRUE(solver.refineActiveSet(request, x, y, info));
-  residual = 0.0;
-  const Eigen::VectorXd r = qp.C * x.col(0) - request.targets.col(0);
+/// The largest violation of the active rows of column 0 of x.
+double activeRowsResidual(const BoxQp& qp, const std::vector<char>& active, const Eigen::MatrixXd& targets,
+                          const Eigen::MatrixXd& x) {
+  double residual = 0.0;
+  const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
   for (Index i = 0; i < r.size(); ++i) {
-    if (request.active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
+    if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
   }
+  return residual;
+}
+
+/// The refinements `request` (of column 0, from the solver's iterate) ran, and in
+/// `residual` the largest violation of its active rows after them (in `x` the result).
+int refineColumnZero(compute::AdmmSolver& solver, const BoxQp& qp, const compute::ActiveSetRefinement& request,
+                     double& residual, Eigen::MatrixXd* x = nullptr) {
+  compute::ActiveSetRefinementInfo info;
+  Eigen::MatrixXd refined, y;
+  EXPECT_TRUE(solver.refineActiveSet(request, refined, y, info));
+  residual = activeRowsResidual(qp, request.active, request.targets, refined);
+  if (x) *x = std::move(refined);
   return info.refinements;
+}
+
+/// The ADMM's active set and targets of `qp`, the targets then moved by 1e-3 (as a loop's
+/// next exact step moves them), so that the ADMM's iterate is far from the active-set
+/// solution `xReference`: the start of the far-start tests.
+void farStartActiveSet(vk::Context& context, const BoxQp& qp, std::vector<char>& active, Eigen::MatrixXd& targets,
+                       Eigen::MatrixXd& xReference) {
+  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context, qp, compute::AdmmSettings{}, active, targets));
+  for (Index i = 0; i < targets.rows(); ++i) targets(i, 0) += 1e-3 * std::cos(static_cast<double>(3 * i));
+  Eigen::MatrixXd yReference;
+  activeSetReference(qp, active, targets, xReference, yReference);
 }
 
 TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionShowsIt) {
@@ -985,15 +1004,7 @@ TEST_F(VulkanAdmm, ARefinementOutOfItsReachGoesOnForItsStepsAtTheStiffPenaltyAnd
     compute::ActiveSetRefinement request{active, targets, {0}, 1.0, 60, kGoal, {}, false};
     request.reach = kGoal;
     request.stiffRho = stiffRho;
-    compute::ActiveSetRefinementInfo info;
-    Eigen::MatrixXd y;
-    EXPECT_TRUE(solver->refineActiveSet(request, x, y, info));
-    residual = 0.0;
-    const Eigen::VectorXd r = qp.C * x.col(0) - targets.col(0);
-    for (Index i = 0; i < r.size(); ++i) {
-      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
-    }
-    return info.refinements;
+    return refineColumnZero(*solver, qp, request, residual, &x);
   };
   double givenUpResidual = 0.0, stiffResidual = 0.0;
   Eigen::MatrixXd givenUpX, stiffX;
@@ -1016,11 +1027,8 @@ TEST_F(VulkanAdmm, AStiffPenaltyKeepsItsAccuracyWhenItsRefinementsSolveForTheirS
   const BoxQp qp = randomBoxQp(30, 24, 17);
   const compute::AdmmSettings settings;
   std::vector<char> active;
-  Eigen::MatrixXd targets;
-  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context(), qp, settings, active, targets));
-  for (Index i = 0; i < targets.rows(); ++i) targets(i, 0) += 1e-3 * std::cos(static_cast<double>(3 * i));
-  Eigen::MatrixXd xReference, yReference;
-  activeSetReference(qp, active, targets, xReference, yReference);
+  Eigen::MatrixXd targets, xReference;
+  ASSERT_NO_FATAL_FAILURE(farStartActiveSet(context(), qp, active, targets, xReference));
   const auto refine = [&](bool forSteps, Eigen::MatrixXd& x) {
     auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
     runAdmm(*solver, qp);
@@ -1077,11 +1085,8 @@ TEST_F(VulkanAdmm, AFarStartSolvesItsPlainRefinementsLooselyAndReachesTheSameSol
   const BoxQp qp = randomBoxQp(30, 24, 17);
   const compute::AdmmSettings settings;
   std::vector<char> active;
-  Eigen::MatrixXd targets;
-  ASSERT_NO_FATAL_FAILURE(admmActiveSet(context(), qp, settings, active, targets));
-  for (Index i = 0; i < targets.rows(); ++i) targets(i, 0) += 1e-3 * std::cos(static_cast<double>(3 * i));
-  Eigen::MatrixXd xReference, yReference;
-  activeSetReference(qp, active, targets, xReference, yReference);
+  Eigen::MatrixXd targets, xReference;
+  ASSERT_NO_FATAL_FAILURE(farStartActiveSet(context(), qp, active, targets, xReference));
   constexpr double kGoal = 1e-12;
   const auto refine = [&](bool farStart, Eigen::MatrixXd& x) {
     auto solver = deviceSolver(context(), qp, settings, kRecordings[1]);
@@ -1098,12 +1103,7 @@ TEST_F(VulkanAdmm, AFarStartSolvesItsPlainRefinementsLooselyAndReachesTheSameSol
   std::printf("tight plain refinements: %d refinements, %ld PCG iterations; loose: %d, %ld\n", tight.refinements,
               tight.linearIterations, loose.refinements, loose.linearIterations);
   for (const Eigen::MatrixXd* x : {&tightX, &looseX}) {
-    double residual = 0.0;
-    const Eigen::VectorXd r = qp.C * x->col(0) - targets.col(0);
-    for (Index i = 0; i < r.size(); ++i) {
-      if (active[static_cast<std::size_t>(i)]) residual = std::max(residual, std::abs(r(i)));
-    }
-    EXPECT_LE(residual, kGoal);
+    EXPECT_LE(activeRowsResidual(qp, active, targets, *x), kGoal);
     EXPECT_LT(relativeDifference(x->col(0), xReference.col(0)), 1e-9);
   }
   EXPECT_LE(loose.refinements, tight.refinements + 2);

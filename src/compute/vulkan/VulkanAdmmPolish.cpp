@@ -32,46 +32,43 @@ void AdmmKernels::recordPolish() {
   la.copy(p.begin, p.x0, w.x);
   la.scaleRows(p.begin, rowScales_, p.y0, w.y);
   p.begin.end();
-  // With z = b the ADMM's right-hand side is the refinement's:
-  //   sigma x - q + C^T (rho diag(active) b - lambda).
+  // For the new point, with z = b the ADMM's right-hand side is the refinement's:
+  //   sigma x - q + C^T (rho diag(active) b - lambda),   PCG warm-started at x;
+  // for the step (ActiveSetRefinement::forSteps):
+  //   -(P x + q) + C^T w,  w = -(lambda + rho diag(active) (C x - b)),   PCG from zero,
+  // the residual formed before it is scaled by rho (no rho-sized terms cancel), to its
+  // tolerance of ||rhs|| (no rounding floor: rhs shrinks with the step).
   // A solve that needs more continues where it stopped, not restarted: a PCG restarted
   // every few dozen iterations converges far slower on the stiff K_A. Plain refinements
   // solve to the inner solves' tolerance, those with momentum to kPolishSolveTolerance.
-  const auto recordSolve = [&](Sequence& solve, Sequence& resume, double tolerance) {
+  const auto recordSolve = [&](Sequence& solve, Sequence& resume, double tolerance, bool forStep) {
     solve.begin();
-    recordRightHandSide(solve);
-    la.copy(solve, w.x, w.xTilde);
-    recordInnerSolve(solve, cap, SolveTarget::WarmStart, tolerance);
+    if (forStep) {
+      la.spmv(solve, devC_, w.x, w.Cx);
+      la.axpby(solve, -1.0, w.z, 1.0, w.Cx);
+      la.scaleRows(solve, rhoRows_, w.Cx, w.w);
+      la.axpby(solve, -1.0, w.y, -1.0, w.w);
+      la.spmv(solve, devCt_, w.w, w.Ctw);
+      la.spmv(solve, devP_, w.x, w.rhs);
+      la.axpby(solve, 1.0, w.Ctw, -1.0, w.rhs);
+      la.axpby(solve, -1.0, w.q, 1.0, w.rhs);
+      solve.zero(w.xTilde.data(), std::size_t{w.xTilde.n()} * w.xTilde.m() * sizeof(double));
+      solve.barrier();
+    } else {
+      recordRightHandSide(solve);
+      la.copy(solve, w.x, w.xTilde);
+    }
+    recordInnerSolve(solve, cap, forStep ? SolveTarget::RightHandSide : SolveTarget::WarmStart, tolerance);
     solve.end();
     resume.begin();
     recordInnerSolve(resume, kPolishResumeIterations, SolveTarget::Continuation, tolerance, cap % 2 == 1);
     resume.end();
   };
-  recordSolve(p.solve, p.resume, settings_.linearSolver.relativeTolerance);
-  recordSolve(p.looseSolve, p.looseResume, kPolishSolveTolerance);
-  // For the step: rhs = -(P x + q) + C^T w with w = -(lambda + rho diag(active) (C x - b)),
-  // the residual formed before it is scaled by rho (no rho-sized terms cancel), then PCG
-  // from zero to its tolerance of ||rhs|| (no rounding floor: rhs shrinks with the step).
-  const auto recordStepSolve = [&](Sequence& solve, Sequence& resume, double tolerance) {
-    solve.begin();
-    la.spmv(solve, devC_, w.x, w.Cx);
-    la.axpby(solve, -1.0, w.z, 1.0, w.Cx);
-    la.scaleRows(solve, rhoRows_, w.Cx, w.w);
-    la.axpby(solve, -1.0, w.y, -1.0, w.w);
-    la.spmv(solve, devCt_, w.w, w.Ctw);
-    la.spmv(solve, devP_, w.x, w.rhs);
-    la.axpby(solve, 1.0, w.Ctw, -1.0, w.rhs);
-    la.axpby(solve, -1.0, w.q, 1.0, w.rhs);
-    solve.zero(w.xTilde.data(), std::size_t{w.xTilde.n()} * w.xTilde.m() * sizeof(double));
-    solve.barrier();
-    recordInnerSolve(solve, cap, SolveTarget::RightHandSide, tolerance);
-    solve.end();
-    resume.begin();
-    recordInnerSolve(resume, kPolishResumeIterations, SolveTarget::Continuation, tolerance, cap % 2 == 1);
-    resume.end();
-  };
-  recordStepSolve(p.stepSolve, p.stepResume, settings_.linearSolver.relativeTolerance);
-  recordStepSolve(p.looseStepSolve, p.looseStepResume, kPolishSolveTolerance);
+  const double tight = settings_.linearSolver.relativeTolerance;
+  recordSolve(p.solve, p.resume, tight, false);
+  recordSolve(p.looseSolve, p.looseResume, kPolishSolveTolerance, false);
+  recordSolve(p.stepSolve, p.stepResume, tight, true);
+  recordSolve(p.looseStepSolve, p.looseStepResume, kPolishSolveTolerance, true);
   // r = diag(active) (C x - b) (in zTilde), lambda += rho r, and r's norm (NaN in x or
   // lambda reaches it).
   const auto recordUpdate = [&](Sequence& update, bool step) {
