@@ -990,8 +990,9 @@ TEST_F(VulkanAdmm, ARefinementThatCannotReachItsReachGivesUpOnceItsContractionSh
 TEST_F(VulkanAdmm, ARefinementOutOfItsReachGoesOnForItsStepsAtTheStiffPenaltyAndReachesIt) {
   // ActiveSetRefinement::stiffRho: where the refinements at rho would not reach their
   // reach, they go on from their iterate at the stiff penalty, solving for their steps,
-  // and get there; with the same request but no stiff penalty they give up after 11, as
-  // in the test above.
+  // and get there; with the same request but no stiff penalty they give up before their
+  // cap, as in the test above (measured: after 11 refinements, GCC's build; clang's ADMM
+  // ends elsewhere).
   const BoxQp qp = randomBoxQp(30, 24, 17);
   std::unique_ptr<compute::AdmmSolver> solver;
   std::vector<char> active;
@@ -999,9 +1000,10 @@ TEST_F(VulkanAdmm, ARefinementOutOfItsReachGoesOnForItsStepsAtTheStiffPenaltyAnd
   ASSERT_NO_FATAL_FAILURE(solvedForRefinement(context(), qp, solver, active, targets));
   Eigen::MatrixXd xReference, yReference;
   activeSetReference(qp, active, targets, xReference, yReference);
+  constexpr int kCap = 30;
   constexpr double kGoal = 1e-12;
   const auto refine = [&](double stiffRho, double& residual, Eigen::MatrixXd& x) {
-    compute::ActiveSetRefinement request{active, targets, {0}, 1.0, 60, kGoal, {}, false};
+    compute::ActiveSetRefinement request{active, targets, {0}, 1.0, kCap, kGoal, {}, false};
     request.reach = kGoal;
     request.stiffRho = stiffRho;
     return refineColumnZero(*solver, qp, request, residual, &x);
@@ -1012,7 +1014,7 @@ TEST_F(VulkanAdmm, ARefinementOutOfItsReachGoesOnForItsStepsAtTheStiffPenaltyAnd
   const int stiff = refine(1e8, stiffResidual, stiffX);
   std::printf("rho 1: given up after %d refinements at %.2e; with the stiff penalty %d refinements to %.2e\n",
               givenUp, givenUpResidual, stiff, stiffResidual);
-  EXPECT_EQ(givenUp, 11);
+  EXPECT_LT(givenUp, kCap) << "not given up: no test of going on";
   EXPECT_GT(givenUpResidual, kGoal);
   EXPECT_GT(stiff, givenUp) << "the stiff refinements follow the given-up ones";
   EXPECT_LE(stiffResidual, kGoal);
