@@ -258,12 +258,7 @@ class BoxQpSolver {
   /// rounding (kEqualityPolishResidual in the .cpp); else false, the loaded start again the
   /// iterate, and info.linearIterations and polishRefinements the work spent.
   bool solveEqualitiesInPlace(const compute::AdmmInfo& loaded, const Eigen::MatrixXd& bounds, BoxQpInfo& info);
-  /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
-  /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
-  /// by the kernels; only the sides found (a byte per four rows and columns), the active
-  /// flags of each set and a few norms cross, and the iterate stays for the final download.
-  /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
-  /// untouched: polish() then works from the downloaded iterate).
+  /// How polishInPlace refines each active set.
   struct InPlacePolish {
     int maxRefinements;  ///< Per set.
     /// > 0: give up a set's refinements that would not reach it
@@ -274,6 +269,13 @@ class BoxQpSolver {
     double goal = 0.0;
     double stiffRho = 0.0;  ///< compute::ActiveSetRefinement::stiffRho.
   };
+  /// The polish where the ADMM's kernels keep the iterate, when they find its active sets
+  /// there (compute::AdmmKernels::findActiveSides): one refinement per distinct set, merged
+  /// by the kernels; only the sides found (a byte per four rows and columns), the active
+  /// flags of each set and a few norms cross, and the iterate stays for the final download.
+  /// Sets info.polished and polishRefinements; false when the kernels cannot (iterate
+  /// untouched: polish() then works from the downloaded iterate). `how` says how far and
+  /// at which penalties.
   bool polishInPlace(const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper, BoxQpInfo& info,
                      const InPlacePolish& how);
   bool polish(const Eigen::MatrixXd& q, const Eigen::MatrixXd& lower, const Eigen::MatrixXd& upper,
