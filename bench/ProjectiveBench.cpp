@@ -125,8 +125,11 @@ class InnerSolveSplit {
 
 /// Rigid targets that disagree (a rotation on every other face) with the row v = 0 fixed:
 /// a global step that needs real ADMM work.
+/// `equalitySolve` Admm: the exact step by the ADMM and its polish (until 2026-12-07 the
+/// device's way from zero multipliers) instead of the polish alone.
 void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
-                   plano::compute::AdmmPreconditioner preconditioner = plano::compute::AdmmPreconditioner::Automatic) {
+                   plano::compute::AdmmPreconditioner preconditioner = plano::compute::AdmmPreconditioner::Automatic,
+                   plano::projective::EqualitySolve equalitySolve = plano::projective::EqualitySolve::Automatic) {
   plano::compute::Backend* backend = plano::bench::backendOrSkip(state, choice);
   if (!backend) return;
   plano::bench::MemoryCounters memory(state, backend);
@@ -143,6 +146,7 @@ void BM_GlobalStep(benchmark::State& state, BackendChoice choice,
   plano::projective::GlobalStepSettings settings;
   settings.epsilonStart = plano::projective::EpsilonStart::ExactFirst;
   settings.qp.preconditioner = preconditioner;
+  settings.qp.equalitySolve = equalitySolve;
   // Every repetition solves the identical step: warm-started from the last one's solution
   // (BoxQpSettings::warmStartEqualities, the global step's default) the device's exact
   // step would start solved and take no ADMM iteration.
@@ -569,8 +573,8 @@ BENCHMARK_CAPTURE(BM_RigidLocalStep, vulkan_fused, BackendChoice::Vulkan, RigidL
     ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_RigidLocalStep, vulkan_two_calls, BackendChoice::Vulkan, RigidLocalStep::TwoCalls)
     ->Arg(4096)->Arg(65536)->Arg(262144)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
-// On lavapipe the device global step finishes up to about 1k faces (101 s with the multigrid
-// preconditioner, the default above 64 faces); vulkan_face_blocks is the block-Jacobi baseline.
+// On lavapipe the device global step takes 2.7 / 18.5 / 76 s on 256 / 1k / 4k faces (2026-12-07;
+// vulkan_admm_first 5.8 / 47.5 / 197 s); vulkan_face_blocks is the block-Jacobi baseline.
 BENCHMARK_CAPTURE(BM_GlobalStep, cpu, BackendChoice::Cpu)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Arg(262144)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
@@ -578,6 +582,9 @@ BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_face_blocks, BackendChoice::Vulkan,
     ->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan, BackendChoice::Vulkan)
     ->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Arg(65536)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GlobalStep, vulkan_admm_first, BackendChoice::Vulkan,
+                  plano::compute::AdmmPreconditioner::Automatic, plano::projective::EqualitySolve::Admm)
+    ->Arg(256)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
 // The GPU target's sizes (one iteration each); on lavapipe their buffers pass its 128 MiB
 // binding range and they skip with that error.
 BENCHMARK_CAPTURE(BM_GlobalStep, vulkan, BackendChoice::Vulkan)

@@ -216,10 +216,9 @@ BoxQpInfo BoxQpSolver::solve(const compute::DeviceMatrix& q, const Eigen::Matrix
       // stiffer (4.8 -> 2.5 s).
       admm_->setRho(settings_.rho);
     }
-    // With multipliers to start from (a loop's last solve's, or given), the polish's method
-    // of multipliers where the ADMM's kernels keep the iterate, with no ADMM iteration.
-    const bool multipliers = warm == compute::WarmStart::Kept || y.size() > 0;
-    if (!direct && settings_.equalitySolve == EqualitySolve::Automatic && settings_.polish && multipliers &&
+    // The polish's method of multipliers where the ADMM's kernels keep the iterate, with no
+    // ADMM iteration: from a loop's last solve's multipliers, given ones, or zero ones.
+    if (!direct && settings_.equalitySolve == EqualitySolve::Automatic && settings_.polish &&
         !equalityPolishFellShort_) {
       const compute::AdmmInfo loaded = start ? admm_->load(q, lower, upper, relaxed, *start, y, warm)
                                              : admm_->load(q, lower, upper, relaxed, x, y, warm);

@@ -44,21 +44,22 @@ enum class EqualitySolve {
   /// back to the ADMM.
   Direct,
   Admm,  ///< The ADMM, then the polish, as for any other problem.
-  /// Direct where the backend factors SPD matrices (Backend::factorsSpdMatrices), the ADMM
-  /// on an iterative backend: there the polish's stiff system (rhoP = 1e9 when measured) from a cold
-  /// start needs PCG iterations that grow fast with the mesh. Measured on lavapipe with
-  /// face-block PCG, direct vs ADMM global step: 64 faces 0.71 vs 1.25 s, 256 faces 8.4
-  /// vs 8.0 s, 1k faces a solve did not converge within 10 000 iterations (the fallback
-  /// then took 106 s against the ADMM's 28 s, whose multigrid-preconditioned solves at a
-  /// milder rho scale).
-  /// Except from a start with multipliers (a loop's next exact step, WarmStart::Kept, or
-  /// given ones) where the ADMM's kernels keep the iterate (the device): there the polish's
-  /// method of multipliers runs alone, in place, and stands once its residual is near
-  /// rounding (within BoxQpSettings::equalityPolishIterations refinements, given up as soon
-  /// as their contraction shows it would not get there); else (once per solver) the ADMM
-  /// solves the step from the same start. It saves the ADMM's K and its inversion: lavapipe
-  /// deformations of the 8x8 / 10x10 grids, 36 iterations, 11.5 -> 8.1-8.5 s and 27.0 ->
-  /// 18.4-19.0 s.
+  /// Direct where the backend factors SPD matrices (Backend::factorsSpdMatrices). Where the
+  /// ADMM's kernels keep the iterate (the device), the polish's method of multipliers runs
+  /// alone, in place, from the start's multipliers (a loop's next exact step,
+  /// WarmStart::Kept, or given ones) or from zero ones, and stands once its residual is near
+  /// rounding (within BoxQpSettings::equalityPolishIterations refinements at the mild
+  /// penalty, given up as soon as their contraction shows it would not get there, then at
+  /// equalityPolishStiffRho); else (once per solver) the ADMM solves the step from the same
+  /// start, and the solver's later exact steps. It saves the ADMM's K and its inversion:
+  /// lavapipe deformations of the 8x8 / 10x10 grids, 36 iterations, 11.5 -> 8.1-8.5 s and
+  /// 27.0 -> 18.4-19.0 s (warm steps). From zero multipliers (`BM_GlobalStep/vulkan`,
+  /// 2026-12-07, lavapipe) on 256 / 1k / 4k faces 1 816 / 4 380 / 5 021 -> 909 / 1 598 /
+  /// 2 007 PCG iterations, 5.8 / 47.5 / 197 -> 2.7 / 18.5 / 76 s. Until then those steps
+  /// took the ADMM first: the mild refinements alone crawl there (C's soft modes), and a
+  /// stiff system's PCG iterations from a cold start had grown fast with the mesh (a
+  /// factored solve's penalty, 1e9: 1k faces did not converge within 10 000 iterations).
+  /// The stiff phase goes on from where the mild one stopped, solving for its steps.
   Automatic,
 };
 
@@ -74,7 +75,7 @@ inline constexpr double kFactoredPolishRho = 1e9;
 /// refinements), 1e4 9.2e-13 (8 290, 16 refinements); 1e5 with the device polish's rounding
 /// floor (vk::AdmmKernels::kPolishRoundingFloor) 1.1e-11 (5 629).
 inline constexpr double kIterativePolishRho = 1e5;
-/// The stiff penalty of the polish that solves a warm exact step alone on an iterative
+/// The stiff penalty of the polish that solves an exact step alone on an iterative
 /// backend (EqualitySolve::Automatic), where its refinements at kIterativePolishRho would
 /// not reach rounding (compute::ActiveSetRefinement::stiffRho): they go on solving for
 /// their steps, whose right-hand side leaves no rho-sized rounding, and the stiff penalty
@@ -93,7 +94,7 @@ struct BoxQpSettings : compute::AdmmSettings {
   /// diagonal from the CPU's (max planarity 1.1e-3 % against 1.9e-12 %); with 200 it is
   /// 1.3e-8 from it (2.4e-8 %), for 8 072 -> 10 269 PCG iterations.
   int inPlacePolishIterations = 200;
-  /// Max refinements of the polish that solves a warm exact step alone
+  /// Max refinements of the polish that solves an exact step alone
   /// (EqualitySolve::Automatic on the device). More than polishIterations: falling short
   /// costs the ADMM and a second polish, and the polish's refinements are cheap ones there
   /// (loosely solved: compute::ActiveSetRefinement::farStart). Measured on lavapipe,

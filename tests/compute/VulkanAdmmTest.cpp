@@ -1940,21 +1940,45 @@ TEST_F(VulkanAdmm, GlobalStepOnTheDeviceGivesTheCpuMaps) {
   EXPECT_LT(both.mapDifference(), 1e-10);
 }
 
-TEST_F(VulkanAdmm, TheDevicesAdmmGivesTheMapsTheCpuSolvesDirectly) {
-  // EqualitySolve::Automatic: the CPU (CHOLMOD) solves the ε = 0 step directly; the
-  // device, where the direct solve's PCG iterations from zero multipliers grow fast with
-  // the mesh, takes the ADMM and polishes. One solution.
+TEST_F(VulkanAdmm, AnExactStepFromZeroMultipliersIsSolvedByTheDevicesPolishAloneWithTheCpusMaps) {
+  // EqualitySolve::Automatic: the CPU (CHOLMOD) solves the ε = 0 step directly; the device
+  // runs the polish's method of multipliers from zero multipliers, with no ADMM iteration.
   GlobalStepCase problem(8);
   problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
   const BothBackends both = solveOnBothBackends(problem, backend());
   ASSERT_EQ(both.hostInfo.attempts.size(), 1u);
   ASSERT_EQ(both.deviceInfo.attempts.size(), 1u);
+  const projective::GlobalStepInfo& device = both.deviceInfo;
+  std::printf("%d refinements, %ld PCG iterations, maps %.2e from the CPU's\n", device.polishRefinements,
+              device.linearIterations, both.mapDifference());
   EXPECT_TRUE(both.hostInfo.attempts[0].direct);
   EXPECT_EQ(both.hostInfo.admmIterations, 0);
-  EXPECT_FALSE(both.deviceInfo.attempts[0].direct);
-  EXPECT_GT(both.deviceInfo.admmIterations, 0);
-  EXPECT_EQ(both.deviceInfo.epsilon, 0.0);
-  EXPECT_EQ(both.hostInfo.epsilon, 0.0);
+  EXPECT_EQ(device.status, projective::GlobalStepStatus::Solved);
+  EXPECT_TRUE(device.attempts[0].direct);
+  EXPECT_EQ(device.admmIterations, 0);
+  EXPECT_GT(device.polishRefinements, 0);
+  EXPECT_EQ(device.epsilon, 0.0);
+  EXPECT_LT(device.constraintResidual, 1e-12);
+  EXPECT_LT(both.mapDifference(), 1e-10);
+}
+
+TEST_F(VulkanAdmm, AnExactStepWhosePolishFallsShortFromZeroMultipliersIsSolvedByTheAdmmWithTheCpusMaps) {
+  // Two mild refinements and no stiff penalty: the polish alone falls short, and the ADMM
+  // and its polish solve the step from the same start, to the CPU's direct solution.
+  GlobalStepCase problem(8);
+  problem.settings.qp.equalitySolve = projective::EqualitySolve::Automatic;
+  problem.settings.qp.equalityPolishIterations = 2;
+  problem.settings.qp.equalityPolishStiffRho = 0.0;
+  const BothBackends both = solveOnBothBackends(problem, backend());
+  ASSERT_EQ(both.deviceInfo.attempts.size(), 1u);
+  const projective::GlobalStepInfo& device = both.deviceInfo;
+  std::printf("%d ADMM iterations, %ld PCG iterations, maps %.2e from the CPU's\n", device.admmIterations,
+              device.linearIterations, both.mapDifference());
+  EXPECT_TRUE(both.hostInfo.attempts[0].direct);
+  EXPECT_EQ(device.status, projective::GlobalStepStatus::Solved);
+  EXPECT_FALSE(device.attempts[0].direct);
+  EXPECT_GT(device.admmIterations, 0);
+  EXPECT_EQ(device.epsilon, 0.0);
   EXPECT_LT(both.mapDifference(), 1e-10);  // measured 1.1e-11 on lavapipe (8.0e-12 before the rounding floor)
 }
 

@@ -329,7 +329,8 @@ TEST_F(WholeAlgorithmAgreement, ASubspaceDeformationOfARealGridshellGivesTheCpuM
 TEST_F(WholeAlgorithmAgreement, AProjectiveDeformationOfARealMeshGivesTheCpuMeshWithTheSameIterations) {
   // The double torus (34 planar quads, genus 2): four vertices fixed, another one moved by
   // 1 % of the bounding-box diagonal. Measured: 7 iterations on both backends, each an
-  // exact step (solved directly on the CPU, 20 ADMM iterations on the device).
+  // exact step (solved directly on the CPU, by the polish's method of multipliers alone on
+  // the device).
   PLANO_REQUIRE_SHARED_MESH(path, "double_torus_quads.off");
   const PolygonMesh torus = readMesh(path);
   PositionalConstraints constraints;
