@@ -79,7 +79,10 @@ inline constexpr double kIterativePolishRho = 1e5;
 /// backend (EqualitySolve::Automatic), where its refinements at kIterativePolishRho would
 /// not reach rounding (compute::ActiveSetRefinement::stiffRho): they go on solving for
 /// their steps, whose right-hand side leaves no rho-sized rounding, and the stiff penalty
-/// makes the method of multipliers contract fast where the mild one crawls.
+/// makes the method of multipliers contract fast where the mild one crawls. Measured on
+/// lavapipe, `BM_GlobalStep/vulkan/4096` from zero multipliers (64 mild refinements, 419
+/// PCG iterations, then the stiff ones): 1e6 gives up after 76 (the ADMM then solves the
+/// step), 1e7 62 refinements and 1 725 PCG iterations, 1e8 22 and 1 588, 1e9 15 and 3 931.
 inline constexpr double kIterativeExactStepRho = 1e8;
 
 /// The ADMM's settings (compute::AdmmSettings) and those of the final polish.
