@@ -58,6 +58,7 @@ DeformationInfo Deformation::solve(const Positions& handles, Positions& position
     it.positionalResidual = step.positionalResidual;
     it.admmIterations = step.admmIterations;
     it.linearIterations = step.linearIterations;
+    it.polishRefinements = step.polishRefinements;
     it.attempts = step.attempts;
     it.displacement = displacement;
     it.maxPlanarity = planarity;

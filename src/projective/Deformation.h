@@ -62,6 +62,9 @@ struct DeformationIteration {
   /// Of the ADMM's solves with K: one per ADMM iteration on the CPU, PCG iterations on the
   /// device (GlobalStepInfo::linearIterations).
   long linearIterations = 0;
+  /// Method-of-multipliers refinements of the step's polish or direct equality solve
+  /// (GlobalStepInfo::polishRefinements).
+  int polishRefinements = 0;
   double displacement = 0.0;        ///< Max vertex move this iteration / bounding-box diagonal.
   double maxPlanarity = 0.0;        ///< Percent, after the iteration.
   std::vector<EpsilonAttempt> attempts;  ///< The eps schedule of the global step.

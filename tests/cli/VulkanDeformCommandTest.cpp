@@ -45,6 +45,10 @@ TEST_F(VulkanDeformCommand, ReportsEachIterationsDeviceTransfersAndNoMatrixCross
     EXPECT_GT(transfers["uploaded_bytes"].get<std::uint64_t>(), 0u);
     EXPECT_GT(transfers["downloaded_bytes"].get<std::uint64_t>(), 0u);
     EXPECT_GT(transfers["copies"].get<std::uint64_t>(), 0u);
+    // Every step exact, the first from zero multipliers too: the polish's method of
+    // multipliers alone, no ADMM iteration.
+    EXPECT_EQ(step["admm_iterations"], 0) << step.dump();
+    EXPECT_GT(step["polish_refinements"].get<int>(), 0) << step.dump();
     if (step["iteration"].get<int>() == 1) continue;  // the first uploads the kept solver's matrices
     // Measured 11.5 kB on these 16 faces (0.72 kB per face: corners, 3x3 matrices, scales,
     // the QP's vectors); the polish's K and right-hand sides, built on the host, added about

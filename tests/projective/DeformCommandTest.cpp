@@ -45,6 +45,7 @@ TEST_F(DeformCommand, WritesTheMeshAndAReportWithTheSchedule) {
     EXPECT_EQ(step["epsilon_attempts"].back()["method"], "equality");
     EXPECT_EQ(step["admm_iterations"], 0);
     EXPECT_EQ(step["linear_iterations"], 0);
+    EXPECT_GT(step["polish_refinements"].get<int>(), 0) << "the direct solve's method of multipliers";
   }
   EXPECT_NE(r.err.find("solved directly"), std::string::npos) << r.err;
 }

@@ -68,6 +68,7 @@ nlohmann::json iterationJson(const projective::DeformationIteration& it) {
           {"positional_residual", it.positionalResidual},
           {"admm_iterations", it.admmIterations},
           {"linear_iterations", it.linearIterations},
+          {"polish_refinements", it.polishRefinements},
           {"displacement", it.displacement},
           {"max_planarity", it.maxPlanarity},
           {"epsilon_attempts", epsilonAttemptsJson(it.attempts)}};
